@@ -1,0 +1,96 @@
+#pragma once
+
+#include <charconv>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+namespace mjslam {
+
+/// A field of a `*Params` struct, as visited by `Serialize(Archive*)`. The
+/// archive (YAML reader, writer, `--set` overrides; see config/) reads or
+/// writes `*value` under the key `name`.
+template <typename T>
+struct NameValue {
+  const char* name;
+  T* value;
+};
+
+/// `a->Visit(MJSLAM_NVP(rate_hz));` inside a Params' `Serialize`.
+#define MJSLAM_NVP(field) ::mjslam::NameValue<decltype(field)>{#field, &(field)}
+
+/// One thing wrong with a parameter value: the dotted key (relative to the
+/// struct that validated it), the value as text, and what was expected.
+struct ParamProblem {
+  std::string key;
+  std::string value;
+  std::string expected;
+};
+
+/// Shortest round-trip text of a value, for error messages.
+template <typename T>
+std::string ValueText(const T& value) {
+  if constexpr (std::is_same_v<T, bool>) {
+    return value ? "true" : "false";
+  } else if constexpr (std::is_arithmetic_v<T>) {
+    char buffer[64];
+    const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);
+    return std::string(buffer, result.ptr);
+  } else {
+    return std::string(value);
+  }
+}
+
+/// Collects the problems of a Params struct so that all are reported at once.
+/// Each Params has `std::vector<ParamProblem> Validate() const` built with it.
+class ParamChecker {
+ public:
+  /// Records a problem with `key` unless `ok`.
+  template <typename T>
+  void Require(bool ok, std::string_view key, const T& value,
+               std::string_view expected) {
+    if (!ok) problems_.push_back({std::string(key), ValueText(value), std::string(expected)});
+  }
+  /// value > 0.
+  template <typename T>
+  void Positive(std::string_view key, T value) {
+    Require(value > 0, key, value, "a value > 0");
+  }
+  /// value >= 0.
+  template <typename T>
+  void NonNegative(std::string_view key, T value) {
+    Require(value >= 0, key, value, "a value >= 0");
+  }
+  /// lo <= value <= hi.
+  template <typename T>
+  void InRange(std::string_view key, T value, T lo, T hi) {
+    Require(value >= lo && value <= hi, key, value,
+            "a value in [" + ValueText(lo) + ", " + ValueText(hi) + "]");
+  }
+  /// One of `choices`.
+  void OneOf(std::string_view key, const std::string& value,
+             const std::vector<std::string>& choices);
+  /// Adds the problems of a nested struct, prefixing their keys with `prefix.`.
+  void Merge(std::string_view prefix, const std::vector<ParamProblem>& nested);
+
+  const std::vector<ParamProblem>& problems() const { return problems_; }
+
+ private:
+  std::vector<ParamProblem> problems_;
+};
+
+/// Bad configuration. `what()` lists every problem, one per line.
+class ParamError : public std::runtime_error {
+ public:
+  explicit ParamError(const std::string& message) : std::runtime_error(message) {}
+};
+
+/// Throws ParamError listing `problems` as "key: expected ... (got value)",
+/// each line prefixed with `context` when it is not empty.
+void ThrowIfProblems(const std::vector<ParamProblem>& problems,
+                     std::string_view context = {});
+
+}  // namespace mjslam
