@@ -1,0 +1,79 @@
+#include "app/csv_reader.h"
+
+#include <cmath>
+#include <cstdlib>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+
+namespace mjslam::app {
+namespace {
+
+std::vector<std::string> SplitFields(const std::string& line) {
+  std::vector<std::string> fields;
+  std::string field;
+  std::istringstream in(line);
+  while (std::getline(in, field, ',')) fields.push_back(field);
+  if (!line.empty() && line.back() == ',') fields.emplace_back();
+  return fields;
+}
+
+}  // namespace
+
+int CsvTable::ColumnIndex(const std::string& column) const {
+  for (std::size_t i = 0; i < columns.size(); ++i) {
+    if (columns[i] == column) return static_cast<int>(i);
+  }
+  throw std::runtime_error(path + ": missing column '" + column + "'");
+}
+
+CsvTable ReadCsv(const std::string& path, const std::vector<std::string>& text_columns) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(path + ": cannot read");
+  CsvTable table;
+  table.path = path;
+  std::string line;
+  if (!std::getline(in, line)) throw std::runtime_error(path + ": empty file, expected a header");
+  table.columns = SplitFields(line);
+  std::vector<bool> is_text(table.columns.size(), false);
+  for (std::size_t i = 0; i < table.columns.size(); ++i) {
+    for (const std::string& name : text_columns) is_text[i] = is_text[i] || name == table.columns[i];
+  }
+  int line_number = 1;
+  while (std::getline(in, line)) {
+    ++line_number;
+    if (line.empty()) continue;
+    const std::vector<std::string> fields = SplitFields(line);
+    if (fields.size() != table.columns.size()) {
+      throw std::runtime_error(path + ":" + std::to_string(line_number) + ": expected " +
+                               std::to_string(table.columns.size()) + " fields (got " +
+                               std::to_string(fields.size()) + ")");
+    }
+    std::vector<double> row(fields.size());
+    std::vector<std::string> text;
+    for (std::size_t i = 0; i < fields.size(); ++i) {
+      if (is_text[i]) {
+        text.push_back(fields[i]);
+        row[i] = std::numeric_limits<double>::quiet_NaN();
+        continue;
+      }
+      if (fields[i].empty()) {
+        row[i] = std::numeric_limits<double>::quiet_NaN();
+        continue;
+      }
+      char* end = nullptr;
+      row[i] = std::strtod(fields[i].c_str(), &end);
+      if (end == fields[i].c_str() || *end != '\0') {
+        throw std::runtime_error(path + ":" + std::to_string(line_number) + ": column " +
+                                 table.columns[i] + ": expected a number (got '" + fields[i] +
+                                 "')");
+      }
+    }
+    table.rows.push_back(std::move(row));
+    table.text.push_back(std::move(text));
+  }
+  return table;
+}
+
+}  // namespace mjslam::app

@@ -1,0 +1,114 @@
+// mjslam: the command line. Parses arguments, loads the config, runs, and is
+// (with the tests) the only place that catches errors.
+#include <csignal>
+#include <cstdio>
+#include <exception>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "app/replay.h"
+#include "app/run.h"
+#include "app/run_config.h"
+#include "app/run_files.h"
+
+namespace {
+
+volatile std::sig_atomic_t g_stop_requested = 0;
+
+void RequestStop(int /*signal*/) { g_stop_requested = 1; }
+
+std::string JoinArguments(int argc, char** argv) {
+  std::string text;
+  for (int i = 0; i < argc; ++i) text += (i ? " " : "") + std::string(argv[i]);
+  return text;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  using mjslam::app::RunConfig;
+  CLI::App cli{"mjslam: laser EKF-SLAM testbed on a simulated Pioneer 3-DX (MuJoCo)"};
+  cli.set_version_flag("--version", mjslam::app::MjslamVersion() + " (" +
+                                        mjslam::app::MjslamGitCommit() + ")");
+  cli.require_subcommand(1);
+  const std::string default_config = std::string(MJSLAM_SOURCE_DIR) + "/configs/default.yaml";
+
+  // mjslam run
+  CLI::App* run = cli.add_subcommand("run", "Run one closed-loop simulation and write a run directory");
+  std::string config_path = default_config;
+  std::string world;
+  std::string out_dir;
+  std::uint64_t seed = 0;
+  double duration_s = 0.0;
+  std::vector<std::string> overrides;
+  bool quiet = false;
+  run->add_option("--config", config_path, "YAML config file")->capture_default_str();
+  run->add_option("--world", world, "World MJCF file (overrides run.world)");
+  run->add_option("--seed", seed, "Root random seed (overrides run.seed)");
+  run->add_option("--duration", duration_s, "Simulated seconds (overrides run.duration_s)");
+  run->add_option("--out", out_dir, "Run directory [runs/<world>-seed<seed>]");
+  run->add_option("--set", overrides, "Override any config key: --set laser.range_noise_std_m=0")
+      ->type_name("KEY=VALUE");
+  run->add_flag("--quiet", quiet, "No progress bar");
+
+  // mjslam replay
+  CLI::App* replay =
+      cli.add_subcommand("replay", "Run both filters on the scans and trajectory of an earlier run");
+  std::string scans_path;
+  std::string trajectory_path;
+  replay->add_option("--scans", scans_path, "scans.csv of an earlier run")->required();
+  replay->add_option("--trajectory", trajectory_path,
+                     "Its trajectory.csv [the one beside --scans]");
+  replay->add_option("--config", config_path, "YAML config file")->capture_default_str();
+  replay->add_option("--out", out_dir, "Output directory")->required();
+  replay->add_option("--set", overrides, "Override any config key")->type_name("KEY=VALUE");
+
+  CLI11_PARSE(cli, argc, argv);
+
+  std::signal(SIGINT, RequestStop);
+  std::signal(SIGTERM, RequestStop);
+  try {
+    if (run->parsed()) {
+      // Command-line options are overrides like --set, applied last.
+      if (!world.empty()) overrides.push_back("run.world=" + world);
+      if (run->count("--seed") > 0) overrides.push_back("run.seed=" + std::to_string(seed));
+      if (run->count("--duration") > 0) {
+        overrides.push_back("run.duration_s=" + mjslam::ValueText(duration_s));
+      }
+      const RunConfig config = mjslam::app::LoadRunConfig(config_path, overrides);
+      mjslam::app::RunOptions options;
+      options.out_dir = out_dir;
+      if (options.out_dir.empty()) {
+        const std::string stem = std::filesystem::path(config.run.world).stem().string();
+        options.out_dir = "runs/" + stem + "-seed" + std::to_string(config.run.seed);
+      }
+      options.config_path = config_path;
+      options.command_line = JoinArguments(argc, argv);
+      options.show_progress = !quiet;
+      options.stop_requested = &g_stop_requested;
+      const mjslam::app::RunResult result = mjslam::app::RunSimulation(config, options);
+      std::fprintf(stderr, "%s: %s after %d steps (%.1f s simulated)\n", options.out_dir.c_str(),
+                   result.status.c_str(), result.steps, result.sim_time_s);
+      return result.status == "completed" ? 0 : 130;
+    }
+    if (replay->parsed()) {
+      const RunConfig config = mjslam::app::LoadRunConfig(config_path, overrides);
+      mjslam::app::ReplayOptions options;
+      options.scans_path = scans_path;
+      options.trajectory_path = trajectory_path;
+      options.out_dir = out_dir;
+      options.config_path = config_path;
+      options.command_line = JoinArguments(argc, argv);
+      mjslam::app::Replay(config, options);
+      std::fprintf(stderr, "%s: replay completed\n", out_dir.c_str());
+      return 0;
+    }
+  } catch (const std::exception& error) {
+    std::fprintf(stderr, "mjslam: error:\n%s\n", error.what());
+    return 1;
+  }
+  return 0;
+}

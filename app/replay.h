@@ -1,0 +1,32 @@
+#pragma once
+
+#include <string>
+
+#include "app/run_config.h"
+
+namespace mjslam::app {
+
+/// Inputs of `mjslam replay`.
+struct ReplayOptions {
+  /// scans.csv of an earlier run.
+  std::string scans_path;
+  /// Its trajectory.csv; empty: the one beside `scans_path`.
+  std::string trajectory_path;
+  /// Where to write the outputs.
+  std::string out_dir;
+  std::string config_path;
+  std::string command_line;
+};
+
+/// Runs both filters on recorded data, without the simulator: the records are
+/// rebuilt from the trajectory (true pose for the initial pose, odometry,
+/// held command) and the scans (ranges at the maximum are no-return). The
+/// laser mount comes from the manifest.json beside the scans when there is
+/// one, else from the true poses of the laser and of R at the first scan.
+/// Writes config.yaml, manifest.json, trajectory.csv (same columns as a run)
+/// and the two maps. Given the same config, the filter columns equal those
+/// of the original run except the timings. Throws std::runtime_error naming
+/// the file, line and column of bad input.
+void Replay(const RunConfig& config, const ReplayOptions& options);
+
+}  // namespace mjslam::app

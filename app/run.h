@@ -1,0 +1,45 @@
+#pragma once
+
+#include <csignal>
+#include <string>
+
+#include "app/run_config.h"
+
+namespace mjslam::app {
+
+/// How `mjslam run` was asked to run, beyond the config.
+struct RunOptions {
+  /// The run directory; created if missing, its files replaced.
+  std::string out_dir;
+  /// The config file the run was loaded from and the command line, for the
+  /// manifest.
+  std::string config_path;
+  std::string command_line;
+  /// Draw a progress bar on a terminal.
+  bool show_progress = true;
+  /// Set asynchronously (by a signal handler) to stop the run early; the run
+  /// then ends cleanly with status "interrupted".
+  const volatile std::sig_atomic_t* stop_requested = nullptr;
+};
+
+/// How a run ended.
+struct RunResult {
+  /// "completed" or "interrupted" ("failed" runs throw).
+  std::string status;
+  int steps = 0;
+  double sim_time_s = 0.0;
+};
+
+/// Runs one closed-loop simulation: MuJoCo steps the robot, the laser is cast
+/// at its rate, both filters run on every record, the driver steers. Writes
+/// config.yaml, manifest.json, trajectory.csv, scans.csv, map_classical.csv
+/// and map_selective.csv into `options.out_dir` (see the README). On an error
+/// the files keep every complete row so far, the manifest records the
+/// failure, and the error is rethrown.
+RunResult RunSimulation(const RunConfig& config, const RunOptions& options);
+
+/// Columns of trajectory.csv and scans.csv (the latter for `num_beams`).
+std::vector<std::string> TrajectoryColumns();
+std::vector<std::string> ScanColumns(int num_beams);
+
+}  // namespace mjslam::app

@@ -1,0 +1,74 @@
+#include "app/run_config.h"
+
+#include <cmath>
+#include <filesystem>
+
+#include "config/config.h"
+
+namespace mjslam::app {
+
+std::vector<ParamProblem> RunParams::Validate() const {
+  ParamChecker check;
+  check.Positive("duration_s", duration_s);
+  check.Positive("control_rate_hz", control_rate_hz);
+  check.Require(!world.empty(), "world", world, "a world MJCF file");
+  check.Require(!robot_model.empty(), "robot_model", robot_model, "a robot MJCF file");
+  return check.problems();
+}
+
+std::vector<ParamProblem> RunConfig::Validate() const {
+  ParamChecker check;
+  check.Merge("run", run.Validate());
+  check.Merge("sim", sim.Validate());
+  check.Merge("robot", robot.Validate());
+  check.Merge("laser", laser.Validate());
+  check.Merge("odometry", odometry.Validate());
+  check.Merge("driver", driver.Validate());
+  check.Merge("slam", slam.Validate());
+  // The laser fires on control steps only.
+  if (run.control_rate_hz > 0 && laser.rate_hz > 0) {
+    const double ratio = run.control_rate_hz / laser.rate_hz;
+    check.Require(ratio >= 1.0 - 1e-9 && std::abs(ratio - std::round(ratio)) < 1e-9,
+                  "laser.rate_hz", laser.rate_hz,
+                  "a rate that divides run.control_rate_hz (" +
+                      ValueText(run.control_rate_hz) + ")");
+  }
+  return check.problems();
+}
+
+int RunConfig::StepsPerScan() const {
+  return static_cast<int>(std::lround(run.control_rate_hz / laser.rate_hz));
+}
+
+namespace {
+
+// Makes `path` absolute against `base` when it is relative.
+std::string Absolute(const std::string& path, const std::filesystem::path& base) {
+  std::filesystem::path p(path);
+  if (p.is_relative()) p = base / p;
+  return p.lexically_normal().string();
+}
+
+// True when an override sets `key`.
+bool Overrides(const std::vector<std::string>& overrides, const std::string& key) {
+  for (const std::string& text : overrides) {
+    if (text.rfind(key + "=", 0) == 0) return true;
+  }
+  return false;
+}
+
+}  // namespace
+
+RunConfig LoadRunConfig(const std::string& path, const std::vector<std::string>& overrides) {
+  RunConfig config = config::LoadConfigFile<RunConfig>(path, overrides);
+  const std::filesystem::path config_dir =
+      std::filesystem::absolute(std::filesystem::path(path)).parent_path();
+  const std::filesystem::path cwd = std::filesystem::current_path();
+  config.run.world =
+      Absolute(config.run.world, Overrides(overrides, "run.world") ? cwd : config_dir);
+  config.run.robot_model = Absolute(
+      config.run.robot_model, Overrides(overrides, "run.robot_model") ? cwd : config_dir);
+  return config;
+}
+
+}  // namespace mjslam::app

@@ -1,0 +1,89 @@
+#include "app/run_files.h"
+
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <chrono>
+#include <cstdio>
+#include <cstring>
+#include <ctime>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+
+#include "app/git_commit.h"
+
+namespace mjslam::app {
+
+void WriteFileAtomically(const std::string& path, const std::string& contents) {
+  const std::string temporary = path + ".tmp";
+  {
+    const int fd = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    if (fd < 0) {
+      throw std::runtime_error(path + ": cannot write: " + std::strerror(errno));
+    }
+    std::size_t written = 0;
+    while (written < contents.size()) {
+      const ssize_t n = ::write(fd, contents.data() + written, contents.size() - written);
+      if (n < 0 && errno == EINTR) continue;
+      if (n < 0) {
+        const std::string reason = std::strerror(errno);
+        ::close(fd);
+        std::remove(temporary.c_str());
+        throw std::runtime_error(path + ": write failed: " + reason);
+      }
+      written += static_cast<std::size_t>(n);
+    }
+    ::close(fd);
+  }
+  if (std::rename(temporary.c_str(), path.c_str()) != 0) {
+    const std::string reason = std::strerror(errno);
+    std::remove(temporary.c_str());
+    throw std::runtime_error(path + ": cannot replace: " + reason);
+  }
+}
+
+void WriteJsonAtomically(const std::string& path, const nlohmann::json& value) {
+  WriteFileAtomically(path, value.dump(2) + "\n");
+}
+
+std::string HashFile(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error(path + ": cannot read");
+  std::uint64_t hash = 0xcbf29ce484222325ULL;
+  char buffer[1 << 14];
+  while (in) {
+    in.read(buffer, sizeof(buffer));
+    for (std::streamsize i = 0; i < in.gcount(); ++i) {
+      hash ^= static_cast<unsigned char>(buffer[i]);
+      hash *= 0x100000001b3ULL;
+    }
+  }
+  char text[40];
+  std::snprintf(text, sizeof(text), "fnv1a64:%016llx", static_cast<unsigned long long>(hash));
+  return text;
+}
+
+std::string UtcNow() {
+  const std::time_t now = std::chrono::system_clock::to_time_t(std::chrono::system_clock::now());
+  std::tm utc{};
+  gmtime_r(&now, &utc);
+  char text[32];
+  std::strftime(text, sizeof(text), "%Y-%m-%dT%H:%M:%SZ", &utc);
+  return text;
+}
+
+void MakeRunDirectory(const std::string& dir) {
+  std::error_code error;
+  std::filesystem::create_directories(dir, error);
+  if (error || !std::filesystem::is_directory(dir)) {
+    throw std::runtime_error(dir + ": cannot create the run directory" +
+                             (error ? ": " + error.message() : std::string()));
+  }
+}
+
+std::string MjslamVersion() { return MJSLAM_VERSION; }
+std::string MjslamGitCommit() { return MJSLAM_GIT_COMMIT; }
+
+}  // namespace mjslam::app

@@ -1,0 +1,100 @@
+#include "app/slam_pair.h"
+
+#include <chrono>
+#include <string>
+
+#include "app/run_files.h"
+#include "slam/feature_extraction.h"
+
+namespace mjslam::app {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double MicrosecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double, std::micro>(Clock::now() - start).count();
+}
+
+}  // namespace
+
+SlamPair::SlamPair(const slam::SlamParams& params, const Pose2& X_WR0, const Pose2& X_RS)
+    : params_(params) {
+  filters_.push_back(
+      {"classical", slam::EkfSlam(params.ekf, slam::CorrectionMode::kClassical, X_WR0, X_RS), {}, 0.0});
+  filters_.push_back(
+      {"selective", slam::EkfSlam(params.ekf, slam::CorrectionMode::kSelective, X_WR0, X_RS), {}, 0.0});
+}
+
+void SlamPair::Step(const SensorRecord& record) {
+  slam::ScanFeatures features;
+  double extraction_us = 0.0;
+  if (record.has_scan) {
+    const Clock::time_point start = Clock::now();
+    features = slam::ExtractFeatures(record.scan, params_.features);
+    extraction_us = MicrosecondsSince(start);
+  }
+  for (Filter& f : filters_) {
+    const Clock::time_point start = Clock::now();
+    f.report = f.filter.Step(record, record.has_scan ? &features : nullptr);
+    f.processing_us = extraction_us + MicrosecondsSince(start);
+  }
+}
+
+std::vector<std::string> SlamPair::Columns() {
+  std::vector<std::string> columns;
+  for (const char* prefix : {"classical", "selective"}) {
+    for (const char* name : {"x", "y", "th", "pxx", "pxy", "pxth", "pyy", "pyth", "pthth",
+                             "nfeat", "nmatched", "nupdated", "us"}) {
+      columns.push_back(std::string(prefix) + "_" + name);
+    }
+  }
+  return columns;
+}
+
+void SlamPair::AddColumns(CsvWriter* writer) const {
+  for (const Filter& f : filters_) {
+    const Pose2 X_WR = f.filter.X_WR();
+    const Eigen::Matrix3d P = f.filter.pose_covariance();
+    writer->Add(X_WR.x);
+    writer->Add(X_WR.y);
+    writer->Add(X_WR.theta);
+    writer->Add(P(0, 0));
+    writer->Add(P(0, 1));
+    writer->Add(P(0, 2));
+    writer->Add(P(1, 1));
+    writer->Add(P(1, 2));
+    writer->Add(P(2, 2));
+    writer->Add(f.report.num_features);
+    writer->Add(f.report.num_matched);
+    writer->Add(f.report.num_updated);
+    writer->Add(f.processing_us);
+  }
+}
+
+void SlamPair::WriteMaps(const std::string& dir) const {
+  for (const Filter& f : filters_) {
+    WriteMapCsv(dir + "/map_" + f.name + ".csv", f.filter.Map());
+  }
+}
+
+void WriteMapCsv(const std::string& path, const std::vector<slam::MapFeature>& map) {
+  std::string text = "id,type,p0,p1,c00,c01,c11,ax,ay,bx,by\n";
+  for (const slam::MapFeature& feature : map) {
+    const bool line = feature.type == slam::MapFeature::Type::kLine;
+    text += std::to_string(feature.id) + (line ? ",line," : ",corner,");
+    for (const double v : {feature.params.x(), feature.params.y(), feature.covariance(0, 0),
+                           feature.covariance(0, 1), feature.covariance(1, 1)}) {
+      text += FormatDouble(v) + ",";
+    }
+    if (line && feature.has_segment) {
+      text += FormatDouble(feature.p_WA.x()) + "," + FormatDouble(feature.p_WA.y()) + "," +
+              FormatDouble(feature.p_WB.x()) + "," + FormatDouble(feature.p_WB.y());
+    } else {
+      text += ",,,";
+    }
+    text += "\n";
+  }
+  WriteFileAtomically(path, text);
+}
+
+}  // namespace mjslam::app

@@ -1,0 +1,53 @@
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "app/csv_writer.h"
+#include "common/records.h"
+#include "slam/ekf_slam.h"
+#include "slam/slam_params.h"
+
+namespace mjslam::app {
+
+/// The two filters of the paper on the same records: the classical sequential
+/// EKF and the selective one. Features are extracted once per scan and given
+/// to both; each filter's processing time is that extraction plus its own
+/// step, measured with a steady clock.
+class SlamPair {
+ public:
+  /// X_WR0: known initial pose of R; X_RS: the laser mount on R.
+  SlamPair(const slam::SlamParams& params, const Pose2& X_WR0, const Pose2& X_RS);
+
+  /// Runs both filters on one record.
+  void Step(const SensorRecord& record);
+
+  /// The per-filter columns of trajectory.csv, for prefixes "classical" and
+  /// "selective": f_x,f_y,f_th,f_pxx,f_pxy,f_pxth,f_pyy,f_pyth,f_pthth,
+  /// f_nfeat,f_nmatched,f_nupdated,f_us.
+  static std::vector<std::string> Columns();
+  /// Appends the values of Columns() for the last step.
+  void AddColumns(CsvWriter* writer) const;
+
+  /// Writes map_classical.csv and map_selective.csv into `dir`.
+  void WriteMaps(const std::string& dir) const;
+
+  const slam::EkfSlam& classical() const { return filters_[0].filter; }
+  const slam::EkfSlam& selective() const { return filters_[1].filter; }
+
+ private:
+  struct Filter {
+    std::string name;
+    slam::EkfSlam filter;
+    slam::StepReport report;
+    double processing_us = 0.0;
+  };
+  slam::SlamParams params_;
+  std::vector<Filter> filters_;
+};
+
+/// Writes one filter map as CSV (id,type,p0,p1,c00,c01,c11,ax,ay,bx,by),
+/// atomically.
+void WriteMapCsv(const std::string& path, const std::vector<slam::MapFeature>& map);
+
+}  // namespace mjslam::app

@@ -1,0 +1,251 @@
+#include "config/archive.h"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <limits>
+#include <string_view>
+#include <system_error>
+
+namespace mjslam::config::internal {
+namespace {
+
+using Kind = ConfigNode::Kind;
+
+// Longest text shown for a value in "(got ...)".
+constexpr std::size_t kMaxValueText = 60;
+
+// Drops one leading '+' (YAML allows it, std::from_chars does not).
+std::string_view WithoutPlus(std::string_view text) {
+  if (text.size() > 1 && text[0] == '+' && text[1] != '-' && text[1] != '+') {
+    text.remove_prefix(1);
+  }
+  return text;
+}
+
+// from_chars over the whole text, or nothing.
+template <typename T>
+std::errc ParseWhole(std::string_view text, T* value) {
+  if (text.empty()) return std::errc::invalid_argument;
+  const auto result = std::from_chars(text.data(), text.data() + text.size(), *value);
+  if (result.ec != std::errc()) return result.ec;
+  if (result.ptr != text.data() + text.size()) return std::errc::invalid_argument;
+  return std::errc();
+}
+
+// YAML 1.2 core-schema floats: [-+]digits[.digits][e[-+]digits], .inf, .nan.
+std::errc ParseDouble(const std::string& text, double* value) {
+  if (text == ".inf" || text == ".Inf" || text == ".INF" || text == "+.inf" ||
+      text == "+.Inf" || text == "+.INF") {
+    *value = std::numeric_limits<double>::infinity();
+    return std::errc();
+  }
+  if (text == "-.inf" || text == "-.Inf" || text == "-.INF") {
+    *value = -std::numeric_limits<double>::infinity();
+    return std::errc();
+  }
+  if (text == ".nan" || text == ".NaN" || text == ".NAN") {
+    *value = std::numeric_limits<double>::quiet_NaN();
+    return std::errc();
+  }
+  // Only digits, sign, '.', exponent: rejects from_chars' "inf", "nan", "0x1p3".
+  const std::string_view body = WithoutPlus(text);
+  if (body.find_first_not_of("0123456789+-.eE") != std::string_view::npos) {
+    return std::errc::invalid_argument;
+  }
+  return ParseWhole(body, value);
+}
+
+bool IsPlainScalar(const ConfigNode& node) {
+  return node.kind == Kind::kScalar && !node.quoted;
+}
+
+// Levenshtein distance, for "did you mean" suggestions.
+std::size_t EditDistance(const std::string& a, const std::string& b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diagonal = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t above = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1,
+                         diagonal + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diagonal = above;
+    }
+  }
+  return row[b.size()];
+}
+
+}  // namespace
+
+void MarkTable::Record(const std::string& key, const SourceMark& mark, bool is_struct) {
+  marks_[key] = Recorded{mark, is_struct};
+}
+
+SourceMark MarkTable::Find(const std::string& key, const std::string& source) const {
+  // The key itself (a field, an element, or a nested struct).
+  if (const auto it = marks_.find(key); it != marks_.end()) return it->second.mark;
+
+  // Else the closest enclosing field or element: "a.b[2][0]" -> "a.b[2]" -> "a.b".
+  std::string prefix = key;
+  for (;;) {
+    const std::size_t cut = prefix.find_last_of(".[");
+    if (cut == std::string::npos || cut == 0) break;
+    prefix.resize(cut);
+    const auto it = marks_.find(prefix);
+    if (it != marks_.end()) {
+      if (it->second.is_struct) break;
+      return it->second.mark;
+    }
+  }
+
+  // Not in the text: the value is a default.
+  return SourceMark{source, 0, 0};
+}
+
+std::string NodeText(const ConfigNode& node) {
+  switch (node.kind) {
+    case Kind::kNull:
+      return "null";
+    case Kind::kMap:
+      return "a map";
+    case Kind::kSequence:
+      return "a sequence of " + std::to_string(node.items.size()) +
+             (node.items.size() == 1 ? " item" : " items");
+    case Kind::kScalar:
+      break;
+  }
+  std::string text = node.scalar;
+  if (text.size() > kMaxValueText) text = text.substr(0, kMaxValueText - 3) + "...";
+  return node.quoted ? "\"" + text + "\"" : text;
+}
+
+bool ReadLeaf(const ConfigNode& node, double* value, std::string* expected) {
+  *expected = node.quoted ? "an unquoted number" : "a number";
+  if (!IsPlainScalar(node)) return false;
+  const std::errc ec = ParseDouble(node.scalar, value);
+  if (ec == std::errc::result_out_of_range) *expected = "a number within the range of a double";
+  return ec == std::errc();
+}
+
+bool ReadLeaf(const ConfigNode& node, int* value, std::string* expected) {
+  *expected = node.quoted ? "an unquoted integer" : "an integer";
+  if (!IsPlainScalar(node)) return false;
+  const std::errc ec = ParseWhole(WithoutPlus(node.scalar), value);
+  if (ec == std::errc::result_out_of_range) {
+    *expected = "an integer in [" + std::to_string(std::numeric_limits<int>::min()) + ", " +
+                std::to_string(std::numeric_limits<int>::max()) + "]";
+  }
+  return ec == std::errc();
+}
+
+bool ReadLeaf(const ConfigNode& node, std::uint64_t* value, std::string* expected) {
+  *expected = node.quoted ? "an unquoted non-negative integer" : "a non-negative integer";
+  if (!IsPlainScalar(node)) return false;
+  const std::errc ec = ParseWhole(WithoutPlus(node.scalar), value);
+  if (ec == std::errc::result_out_of_range) {
+    *expected = "a non-negative integer <= " +
+                std::to_string(std::numeric_limits<std::uint64_t>::max());
+  }
+  return ec == std::errc();
+}
+
+bool ReadLeaf(const ConfigNode& node, bool* value, std::string* expected) {
+  *expected = node.quoted ? "unquoted true or false" : "true or false";
+  if (!IsPlainScalar(node)) return false;
+  const std::string& text = node.scalar;
+  if (text == "true" || text == "True" || text == "TRUE") {
+    *value = true;
+    return true;
+  }
+  if (text == "false" || text == "False" || text == "FALSE") {
+    *value = false;
+    return true;
+  }
+  return false;
+}
+
+bool ReadLeaf(const ConfigNode& node, std::string* value, std::string* expected) {
+  *expected = "a string";
+  if (node.kind != Kind::kScalar) return false;
+  *value = node.scalar;
+  return true;
+}
+
+ConfigNode WriteLeaf(double value) {
+  if (std::isnan(value)) return ScalarNode(".nan", false);
+  if (std::isinf(value)) return ScalarNode(value > 0 ? ".inf" : "-.inf", false);
+
+  // Shortest text that reads back to the same double.
+  char buffer[64];
+  const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);
+  std::string text(buffer, result.ptr);
+
+  // Keep a '.' in the mantissa so every YAML reader sees a float: "3" -> "3.0",
+  // "1e-09" -> "1.0e-09".
+  if (text.find('.') == std::string::npos) {
+    const std::size_t exponent = text.find('e');
+    if (exponent == std::string::npos) {
+      text += ".0";
+    } else {
+      text.insert(exponent, ".0");
+    }
+  }
+  return ScalarNode(std::move(text), false);
+}
+
+ConfigNode WriteLeaf(int value) { return ScalarNode(std::to_string(value), false); }
+
+ConfigNode WriteLeaf(bool value) { return ScalarNode(value ? "true" : "false", false); }
+
+ConfigNode WriteLeaf(std::uint64_t value) { return ScalarNode(std::to_string(value), false); }
+
+ConfigNode WriteLeaf(const std::string& value) { return ScalarNode(value, true); }
+
+void ReadArchive::Finish() {
+  const std::vector<ConfigEntry>& entries = map_.entries;
+  for (std::size_t i = 0; i < entries.size(); ++i) {
+    const ConfigEntry& entry = entries[i];
+    const std::string key = JoinKey(prefix_, entry.key.c_str());
+
+    // A key seen before at this level.
+    const auto first = std::find_if(entries.begin(), entries.begin() + static_cast<std::ptrdiff_t>(i),
+                                    [&](const ConfigEntry& e) { return e.key == entry.key; });
+    if (first != entries.begin() + static_cast<std::ptrdiff_t>(i)) {
+      context_->Problem(entry.key_mark, key,
+                        "duplicate key (first given at " + FormatMark(first->key_mark) + ")");
+      continue;
+    }
+
+    // A key that no field visited: list the known ones, suggest the closest.
+    if (std::find(known_.begin(), known_.end(), entry.key) != known_.end()) continue;
+    std::string message = "unknown key";
+    std::size_t best_distance = std::numeric_limits<std::size_t>::max();
+    const std::string* best = nullptr;
+    for (const std::string& name : known_) {
+      const std::size_t distance = EditDistance(entry.key, name);
+      if (distance < best_distance) {
+        best_distance = distance;
+        best = &name;
+      }
+    }
+    if (best != nullptr && (best_distance <= 2 || best_distance * 3 <= entry.key.size())) {
+      message += ", did you mean '" + *best + "'?";
+    }
+    if (known_.empty()) {
+      message += " (no keys are known here)";
+    } else {
+      message += " (known keys";
+      message += prefix_.empty() ? "" : " of " + prefix_;
+      message += ":";
+      for (std::size_t k = 0; k < known_.size(); ++k) {
+        message += (k == 0 ? " " : ", ") + known_[k];
+      }
+      message += ")";
+    }
+    context_->Problem(entry.key_mark, key, message);
+  }
+}
+
+}  // namespace mjslam::config::internal

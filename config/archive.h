@@ -1,0 +1,270 @@
+#pragma once
+
+// Archives that visit a Params struct's `Serialize(Archive*)` over a ConfigNode
+// tree: ReadArchive fills the struct (collecting problems), WriteArchive builds
+// the tree of every field. Header-only templates, free of yaml-cpp; the
+// non-template parts live in config/archive.cc. Users call config/config.h.
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <map>
+#include <string>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+#include "common/params.h"
+#include "config/config_node.h"
+
+namespace mjslam::config::internal {
+
+class ReadArchive;
+
+/// True when T has `template <typename Archive> void Serialize(Archive*)`.
+template <typename T, typename = void>
+struct HasSerialize : std::false_type {};
+template <typename T>
+struct HasSerialize<T, std::void_t<decltype(std::declval<T&>().Serialize(
+                           std::declval<ReadArchive*>()))>> : std::true_type {};
+
+/// True when T has `std::vector<ParamProblem> Validate() const`.
+template <typename T, typename = void>
+struct HasValidate : std::false_type {};
+template <typename T>
+struct HasValidate<T, std::void_t<decltype(std::declval<const T&>().Validate())>>
+    : std::true_type {};
+
+template <typename T>
+struct IsVector : std::false_type {};
+template <typename U, typename A>
+struct IsVector<std::vector<U, A>> : std::true_type {};
+
+template <typename T>
+struct IsArray : std::false_type {};
+template <typename U, std::size_t N>
+struct IsArray<std::array<U, N>> : std::true_type {};
+
+/// Scalar field types read and written by ReadLeaf / WriteLeaf.
+template <typename T>
+inline constexpr bool kIsLeaf =
+    std::is_same_v<T, double> || std::is_same_v<T, int> || std::is_same_v<T, bool> ||
+    std::is_same_v<T, std::uint64_t> || std::is_same_v<T, std::string>;
+
+/// The mark of every value read, by dotted key ("laser.rate_hz",
+/// "driver.waypoints[1][0]"), so that problems from `Validate()` can point at
+/// the text that set the value.
+class MarkTable {
+ public:
+  /// Records where `key` was set; `is_struct` for nested Params maps.
+  void Record(const std::string& key, const SourceMark& mark, bool is_struct);
+
+  /// The mark recorded for `key`; else for its longest recorded prefix that is
+  /// a field or element (not a struct: "a.b[2]" -> "a.b", "a.b.extra" ->
+  /// "a.b"); else `source` alone (the value came from defaults).
+  SourceMark Find(const std::string& key, const std::string& source) const;
+
+ private:
+  struct Recorded {
+    SourceMark mark;
+    bool is_struct = false;
+  };
+  std::map<std::string, Recorded> marks_;
+};
+
+/// State shared by the archives of one read.
+struct ReadContext {
+  std::vector<ConfigProblem>* problems = nullptr;
+  MarkTable* marks = nullptr;
+
+  void Problem(const SourceMark& mark, const std::string& key, std::string message) {
+    problems->push_back({mark, key, std::move(message)});
+  }
+};
+
+/// Text of a node for "(got ...)": the scalar, quoted when it was quoted;
+/// "null"; "a map"; "a sequence of N items".
+std::string NodeText(const ConfigNode& node);
+
+/// Converts a scalar node to a leaf value. On failure returns false and sets
+/// `expected` (e.g. "a number", "an integer in [-2147483648, 2147483647]").
+/// Numbers: decimal, optional sign; doubles also `.inf`, `-.inf`, `.nan`.
+/// Bools: true/false (also True/TRUE/False/FALSE). Quoted scalars are strings
+/// only. Strings accept any scalar, not null.
+bool ReadLeaf(const ConfigNode& node, double* value, std::string* expected);
+bool ReadLeaf(const ConfigNode& node, int* value, std::string* expected);
+bool ReadLeaf(const ConfigNode& node, bool* value, std::string* expected);
+bool ReadLeaf(const ConfigNode& node, std::uint64_t* value, std::string* expected);
+bool ReadLeaf(const ConfigNode& node, std::string* value, std::string* expected);
+
+/// Shortest text that reads back to the same value. Doubles always carry a
+/// '.' ("3.0", "1.0e-09", ".inf", ".nan") so YAML 1.1 readers see floats.
+ConfigNode WriteLeaf(double value);
+ConfigNode WriteLeaf(int value);
+ConfigNode WriteLeaf(bool value);
+ConfigNode WriteLeaf(std::uint64_t value);
+ConfigNode WriteLeaf(const std::string& value);
+
+/// "a.b" from "a" and "b"; "b" when `prefix` is empty.
+inline std::string JoinKey(const std::string& prefix, const char* name) {
+  return prefix.empty() ? std::string(name) : prefix + "." + name;
+}
+
+/// What a field of type T must look like, for "expected ..." messages.
+template <typename T>
+std::string Describe(bool plural) {
+  if constexpr (HasSerialize<T>::value) {
+    return plural ? "maps of keys" : "a map of keys";
+  } else if constexpr (IsVector<T>::value) {
+    return std::string(plural ? "sequences of " : "a sequence of ") +
+           Describe<typename T::value_type>(true);
+  } else if constexpr (IsArray<T>::value) {
+    return std::string(plural ? "sequences of " : "a sequence of ") +
+           std::to_string(std::tuple_size_v<T>) + " " +
+           Describe<typename T::value_type>(true);
+  } else if constexpr (std::is_same_v<T, double>) {
+    return plural ? "numbers" : "a number";
+  } else if constexpr (std::is_same_v<T, int>) {
+    return plural ? "integers" : "an integer";
+  } else if constexpr (std::is_same_v<T, std::uint64_t>) {
+    return plural ? "non-negative integers" : "a non-negative integer";
+  } else if constexpr (std::is_same_v<T, bool>) {
+    return plural ? "booleans" : "true or false";
+  } else {
+    return plural ? "strings" : "a string";
+  }
+}
+
+/// Reads `node` into `*value` (key `key`). On a problem, records it and
+/// leaves `*value` as it was; returns whether the read succeeded.
+template <typename T>
+bool ReadValue(const ConfigNode& node, const std::string& key, T* value,
+               ReadContext* context);
+
+/// Visits the fields of a Params struct while reading one map node.
+class ReadArchive {
+ public:
+  /// `map` must be a kMap node; `prefix` is its dotted key ("" at the top).
+  ReadArchive(const ConfigNode& map, std::string prefix, ReadContext* context)
+      : map_(map), prefix_(std::move(prefix)), context_(context) {}
+
+  /// Reads field `field.name` if the map has it (first occurrence); absent
+  /// keys keep their current (default) value.
+  template <typename T>
+  void Visit(const NameValue<T>& field) {
+    known_.emplace_back(field.name);
+    for (const ConfigEntry& entry : map_.entries) {
+      if (entry.key == field.name) {
+        ReadValue(entry.value, JoinKey(prefix_, field.name), field.value, context_);
+        return;
+      }
+    }
+  }
+
+  /// After Serialize: reports duplicate keys and keys no field visited
+  /// (listing the known keys of this level).
+  void Finish();
+
+ private:
+  const ConfigNode& map_;
+  std::string prefix_;
+  ReadContext* context_;
+  std::vector<std::string> known_;
+};
+
+template <typename T>
+bool ReadValue(const ConfigNode& node, const std::string& key, T* value,
+               ReadContext* context) {
+  using Kind = ConfigNode::Kind;
+  context->marks->Record(key, node.mark, HasSerialize<T>::value);
+  if constexpr (HasSerialize<T>::value) {
+    // Nested Params: a map (null, e.g. `laser:` alone, keeps every default).
+    if (node.kind == Kind::kNull) return true;
+    if (node.kind != Kind::kMap) {
+      context->Problem(node.mark, key,
+                       "expected " + Describe<T>(false) + " (got " + NodeText(node) + ")");
+      return false;
+    }
+    const std::size_t problems_before = context->problems->size();
+    ReadArchive archive(node, key, context);
+    value->Serialize(&archive);
+    archive.Finish();
+    return context->problems->size() == problems_before;
+  } else if constexpr (IsVector<T>::value || IsArray<T>::value) {
+    // Sequences: read every item into a copy, assign only when all are good.
+    bool length_ok = node.kind == Kind::kSequence;
+    if constexpr (IsArray<T>::value) {
+      length_ok = length_ok && node.items.size() == std::tuple_size_v<T>;
+    }
+    if (!length_ok) {
+      context->Problem(node.mark, key,
+                       "expected " + Describe<T>(false) + " (got " + NodeText(node) + ")");
+      return false;
+    }
+    T parsed{};
+    if constexpr (IsVector<T>::value) parsed.resize(node.items.size());
+    bool ok = true;
+    for (std::size_t i = 0; i < node.items.size(); ++i) {
+      ok = ReadValue(node.items[i], key + "[" + std::to_string(i) + "]", &parsed[i],
+                     context) &&
+           ok;
+    }
+    if (ok) *value = std::move(parsed);
+    return ok;
+  } else {
+    static_assert(kIsLeaf<T>,
+                  "unsupported Params field type: use double, int, bool, std::uint64_t, "
+                  "std::string, std::vector/std::array of those, or a struct with "
+                  "Serialize");
+    T parsed{};
+    std::string expected;
+    if (!ReadLeaf(node, &parsed, &expected)) {
+      context->Problem(node.mark, key,
+                       "expected " + expected + " (got " + NodeText(node) + ")");
+      return false;
+    }
+    *value = std::move(parsed);
+    return true;
+  }
+}
+
+template <typename T>
+ConfigNode WriteValue(const T& value);
+
+/// Visits the fields of a Params struct while building one map node.
+class WriteArchive {
+ public:
+  /// `map` must be a kMap node; fields are appended in visiting order.
+  explicit WriteArchive(ConfigNode* map) : map_(map) {}
+
+  template <typename T>
+  void Visit(const NameValue<T>& field) {
+    map_->entries.push_back(ConfigEntry{field.name, SourceMark{}, WriteValue(*field.value)});
+  }
+
+ private:
+  ConfigNode* map_;
+};
+
+/// The tree of `value`: a map for Params structs, sequences for vectors and
+/// arrays, scalars for leaves.
+template <typename T>
+ConfigNode WriteValue(const T& value) {
+  if constexpr (HasSerialize<T>::value) {
+    // Serialize is not const (it hands out field pointers): visit a copy.
+    T copy = value;
+    ConfigNode node = MapNode();
+    WriteArchive archive(&node);
+    copy.Serialize(&archive);
+    return node;
+  } else if constexpr (IsVector<T>::value || IsArray<T>::value) {
+    ConfigNode node = SequenceNode();
+    for (const auto& item : value) node.items.push_back(WriteValue(item));
+    return node;
+  } else {
+    static_assert(kIsLeaf<T>, "unsupported Params field type");
+    return WriteLeaf(value);
+  }
+}
+
+}  // namespace mjslam::config::internal

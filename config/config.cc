@@ -1,0 +1,170 @@
+#include "config/config.h"
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <memory>
+
+namespace mjslam::config::internal {
+namespace {
+
+using Kind = ConfigNode::Kind;
+
+// Trims spaces and tabs at both ends.
+std::string Trim(const std::string& text) {
+  const std::size_t begin = text.find_first_not_of(" \t");
+  if (begin == std::string::npos) return {};
+  const std::size_t end = text.find_last_not_of(" \t");
+  return text.substr(begin, end - begin + 1);
+}
+
+// "a.b.c" -> {"a", "b", "c"}; empty parts are kept (and rejected by the caller).
+std::vector<std::string> SplitKey(const std::string& key) {
+  std::vector<std::string> parts;
+  std::size_t start = 0;
+  for (;;) {
+    const std::size_t dot = key.find('.', start);
+    parts.push_back(key.substr(start, dot == std::string::npos ? std::string::npos : dot - start));
+    if (dot == std::string::npos) return parts;
+    start = dot + 1;
+  }
+}
+
+// The first entry of a map with `key`, or null.
+ConfigEntry* FindEntry(ConfigNode* map, const std::string& key) {
+  for (ConfigEntry& entry : map->entries) {
+    if (entry.key == key) return &entry;
+  }
+  return nullptr;
+}
+
+// Gives every node of an override value the option's mark.
+void Remark(ConfigNode* node, const SourceMark& mark) {
+  node->mark = mark;
+  for (ConfigNode& item : node->items) Remark(&item, mark);
+  for (ConfigEntry& entry : node->entries) {
+    entry.key_mark = mark;
+    Remark(&entry.value, mark);
+  }
+}
+
+// Maps merge key by key; anything else replaces.
+void Merge(ConfigNode* target, const ConfigNode& value) {
+  if (target->kind != Kind::kMap || value.kind != Kind::kMap) {
+    *target = value;
+    return;
+  }
+  for (const ConfigEntry& entry : value.entries) {
+    if (ConfigEntry* existing = FindEntry(target, entry.key)) {
+      Merge(&existing->value, entry.value);
+    } else {
+      target->entries.push_back(entry);
+    }
+  }
+}
+
+}  // namespace
+
+std::string ReadTextFile(const std::string& path) {
+  const auto fail = [&path](const std::string& reason) {
+    throw ConfigError({ConfigProblem{SourceMark{path, 0, 0}, "",
+                                     "cannot read config file (" + reason + ")"}});
+  };
+
+  // fopen succeeds on a directory; reading it would fail with a vaguer reason.
+  std::error_code ec;
+  if (std::filesystem::is_directory(path, ec)) fail("is a directory");
+
+  struct Closer {
+    void operator()(std::FILE* f) const { std::fclose(f); }
+  };
+  const std::unique_ptr<std::FILE, Closer> file(std::fopen(path.c_str(), "rb"));
+  if (!file) fail(std::strerror(errno));
+  std::string text;
+  char buffer[65536];
+  for (;;) {
+    const std::size_t n = std::fread(buffer, 1, sizeof(buffer), file.get());
+    text.append(buffer, n);
+    if (n < sizeof(buffer)) break;
+  }
+  if (std::ferror(file.get())) fail(std::strerror(errno));
+  return text;
+}
+
+ConfigNode ParseRoot(const std::string& text, const std::string& source,
+                     std::vector<ConfigProblem>* problems) {
+  ConfigNode root = ParseYaml(text, source, problems);
+  if (root.kind == Kind::kMap) return root;
+  if (root.kind != Kind::kNull) {
+    problems->push_back({root.mark, "",
+                         "expected a map of keys at the top level (got " + NodeText(root) + ")"});
+  }
+  return MapNode(root.mark);
+}
+
+void ApplyOverrides(const std::vector<std::string>& overrides, ConfigNode* root,
+                    std::vector<ConfigProblem>* problems) {
+  for (const std::string& option : overrides) {
+    const SourceMark mark{"--set " + option, 0, 0};
+
+    // "dotted.key=value": split at the first '='.
+    const std::size_t equals = option.find('=');
+    if (equals == std::string::npos) {
+      problems->push_back({mark, "", "expected --set dotted.key=value"});
+      continue;
+    }
+    const std::string key = Trim(option.substr(0, equals));
+    const std::vector<std::string> parts = SplitKey(key);
+    bool parts_ok = true;
+    for (const std::string& part : parts) parts_ok = parts_ok && !part.empty();
+    if (!parts_ok) {
+      problems->push_back({mark, key, "expected a dotted key like laser.range_noise_std_m"});
+      continue;
+    }
+
+    // The value is YAML: a scalar, or a flow sequence or map.
+    std::vector<ConfigProblem> value_problems;
+    ConfigNode value = ParseYaml(option.substr(equals + 1), mark.source, &value_problems);
+    if (!value_problems.empty()) {
+      for (const ConfigProblem& problem : value_problems) {
+        std::string message = problem.message;
+        const std::string syntax = "YAML syntax error: ";
+        if (message.compare(0, syntax.size(), syntax) == 0) message.erase(0, syntax.size());
+        if (problem.mark.line > 0) message += " (column " + std::to_string(problem.mark.column) + ")";
+        problems->push_back({mark, key, "invalid YAML value: " + message});
+      }
+      continue;
+    }
+    Remark(&value, mark);
+
+    // Walk (or create) the maps down to the last key part, then merge there.
+    ConfigNode* node = root;
+    for (std::size_t i = 0; i + 1 < parts.size(); ++i) {
+      ConfigEntry* entry = FindEntry(node, parts[i]);
+      if (entry == nullptr) {
+        node->entries.push_back(ConfigEntry{parts[i], mark, MapNode(mark)});
+        entry = &node->entries.back();
+      } else if (entry->value.kind != Kind::kMap) {
+        entry->value = MapNode(mark);
+      }
+      node = &entry->value;
+    }
+    if (ConfigEntry* entry = FindEntry(node, parts.back())) {
+      Merge(&entry->value, value);
+    } else {
+      node->entries.push_back(ConfigEntry{parts.back(), mark, std::move(value)});
+    }
+  }
+}
+
+void AddValidationProblems(const std::vector<ParamProblem>& validation,
+                           const MarkTable& marks, const std::string& source,
+                           std::vector<ConfigProblem>* problems) {
+  for (const ParamProblem& problem : validation) {
+    problems->push_back({marks.Find(problem.key, source), problem.key,
+                         "expected " + problem.expected + " (got " + problem.value + ")"});
+  }
+}
+
+}  // namespace mjslam::config::internal

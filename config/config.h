@@ -1,0 +1,100 @@
+#pragma once
+
+// Reads one YAML configuration file (plus `--set key=value` overrides) into a
+// plain Params struct, and writes a Params struct back as YAML. See
+// config/README.md for the error format and the override syntax.
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "common/params.h"
+#include "config/archive.h"
+#include "config/config_node.h"
+
+namespace mjslam::config {
+
+namespace internal {
+
+/// The text of the file at `path`. Throws ConfigError ("path: cannot read
+/// config file (reason)") when it is missing, a directory or unreadable.
+std::string ReadTextFile(const std::string& path);
+
+/// ParseYaml, then makes sure the top level is a map: a kNull document (empty
+/// file) becomes an empty map; anything else is a problem and becomes an empty
+/// map too, so that overrides and defaults still apply.
+ConfigNode ParseRoot(const std::string& text, const std::string& source,
+                     std::vector<ConfigProblem>* problems);
+
+/// Applies each "dotted.key=value" to the map `root`, in order (a later
+/// override of the same key wins). The value text is parsed as YAML; a map
+/// value is merged into an existing map key by key, any other value replaces
+/// the node. Inserted and replaced nodes are marked with the source
+/// "--set dotted.key=value" and no line. Malformed options (no '=', empty key
+/// part, YAML syntax error in the value) are appended to `problems`. Unknown
+/// keys and bad values are left for the reader to report.
+void ApplyOverrides(const std::vector<std::string>& overrides, ConfigNode* root,
+                    std::vector<ConfigProblem>* problems);
+
+/// Maps problems from `Validate()` (keys relative to the top struct) to the
+/// mark of the text that set each key (or `source` alone for defaults).
+void AddValidationProblems(const std::vector<ParamProblem>& validation,
+                           const MarkTable& marks, const std::string& source,
+                           std::vector<ConfigProblem>* problems);
+
+}  // namespace internal
+
+/// Reads `yaml_text` (named `source_name` in messages, e.g. the file path)
+/// into a T that starts from its in-class defaults: keys absent from the text
+/// keep their defaults. Then applies `overrides` ("dotted.key=value", from
+/// `--set` options; the value is YAML, e.g. "driver.waypoints=[[0,0],[1,2]]")
+/// and runs `T::Validate()` (when T has one).
+/// Throws ConfigError listing every problem at once: YAML syntax errors,
+/// unknown keys (with the known keys of that level), duplicate keys, wrong
+/// types, out-of-range values, bad `--set` options. An empty text gives the
+/// defaults (validated).
+template <typename T>
+T LoadConfigString(const std::string& yaml_text, const std::string& source_name,
+                   const std::vector<std::string>& overrides = {}) {
+  static_assert(internal::HasSerialize<T>::value,
+                "T must have template <typename Archive> void Serialize(Archive*)");
+  std::vector<ConfigProblem> problems;
+
+  // Parse the text, then lay the overrides over the tree.
+  ConfigNode root = internal::ParseRoot(yaml_text, source_name, &problems);
+  internal::ApplyOverrides(overrides, &root, &problems);
+
+  // Read the tree into a default-constructed T, recording where each key was set.
+  T params{};
+  internal::MarkTable marks;
+  internal::ReadContext context{&problems, &marks};
+  internal::ReadArchive archive(root, "", &context);
+  params.Serialize(&archive);
+  archive.Finish();
+
+  // Range checks, pointed at the text that set each value.
+  if constexpr (internal::HasValidate<T>::value) {
+    internal::AddValidationProblems(params.Validate(), marks, source_name, &problems);
+  }
+  if (!problems.empty()) throw ConfigError(std::move(problems));
+  return params;
+}
+
+/// LoadConfigString on the text of the file at `path` (named `path` in
+/// messages). Throws ConfigError also when the file is missing or unreadable.
+template <typename T>
+T LoadConfigFile(const std::string& path, const std::vector<std::string>& overrides = {}) {
+  return LoadConfigString<T>(internal::ReadTextFile(path), path, overrides);
+}
+
+/// Block-style YAML of every field of `params` (nested maps for structs),
+/// doubles in shortest round-trip form: LoadConfigString<T>(ToYaml(p), ...)
+/// gives back exactly `p`. Written as `config.yaml` in every run directory.
+template <typename T>
+std::string ToYaml(const T& params) {
+  static_assert(internal::HasSerialize<T>::value,
+                "T must have template <typename Archive> void Serialize(Archive*)");
+  return EmitYaml(internal::WriteValue(params));
+}
+
+}  // namespace mjslam::config

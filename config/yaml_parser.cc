@@ -1,0 +1,129 @@
+// The only file of mjslam that includes yaml-cpp: YAML text -> ConfigNode.
+
+#include <yaml-cpp/yaml.h>
+
+#include <cstddef>
+#include <string>
+#include <vector>
+
+#include "config/config_node.h"
+
+namespace mjslam::config {
+namespace {
+
+// Aliases can build cycles (`a: &x [*x]`) or exponentially large trees that
+// yaml-cpp hands over as shared nodes; the copy stops at these limits.
+constexpr int kMaxDepth = 64;
+constexpr std::size_t kMaxNodes = 1000000;
+
+class Converter {
+ public:
+  Converter(const std::string& source, std::vector<ConfigProblem>* problems)
+      : source_(source), problems_(problems) {}
+
+  // 1-based mark; `fallback` when yaml-cpp has none.
+  SourceMark Mark(const YAML::Mark& mark, const SourceMark& fallback) const {
+    if (mark.is_null() || mark.line < 0) return fallback;
+    return SourceMark{source_, mark.line + 1, mark.column + 1};
+  }
+
+  ConfigNode Convert(const YAML::Node& node, const SourceMark& fallback, int depth) {
+    const SourceMark mark = Mark(node.Mark(), fallback);
+    if (stopped_) return ConfigNode{};
+
+    // Guard against alias cycles and alias bombs.
+    ++count_;
+    if (depth > kMaxDepth || count_ > kMaxNodes) {
+      stopped_ = true;
+      problems_->push_back({mark, "",
+                            "YAML nested deeper than " + std::to_string(kMaxDepth) +
+                                " levels or larger than " + std::to_string(kMaxNodes) +
+                                " nodes (recursive alias?)"});
+      return ConfigNode{};
+    }
+
+    switch (node.Type()) {
+      case YAML::NodeType::Scalar: {
+        // yaml-cpp tags quoted scalars "!", plain ones "?".
+        const std::string& tag = node.Tag();
+        const bool quoted = tag == "!" || tag == "tag:yaml.org,2002:str";
+        return ScalarNode(node.Scalar(), quoted, mark);
+      }
+      case YAML::NodeType::Sequence: {
+        ConfigNode out = SequenceNode(mark);
+        for (const YAML::Node& item : node) out.items.push_back(Convert(item, mark, depth + 1));
+        return out;
+      }
+      case YAML::NodeType::Map: {
+        // Iterate the pairs: duplicate keys are all kept, in order.
+        ConfigNode out = MapNode(mark);
+        for (auto it = node.begin(); it != node.end(); ++it) {
+          const YAML::Node& key = it->first;
+          const YAML::Node& value = it->second;
+          const SourceMark key_mark = Mark(key.Mark(), mark);
+          if (!key.IsScalar()) {
+            problems_->push_back({key_mark, "", "expected a plain key (got a null, map or sequence key)"});
+            continue;
+          }
+          // An empty value (`key:`) is marked by yaml-cpp at the next token: use the key's.
+          SourceMark value_fallback = key_mark;
+          ConfigNode converted = Convert(value, value_fallback, depth + 1);
+          if (value.IsNull() && converted.mark.line != key_mark.line) converted.mark = key_mark;
+          out.entries.push_back(ConfigEntry{key.Scalar(), key_mark, std::move(converted)});
+        }
+        return out;
+      }
+      case YAML::NodeType::Null:
+      case YAML::NodeType::Undefined:
+        break;
+    }
+    ConfigNode null_node;
+    null_node.mark = mark;
+    return null_node;
+  }
+
+ private:
+  const std::string& source_;
+  std::vector<ConfigProblem>* problems_;
+  std::size_t count_ = 0;
+  bool stopped_ = false;
+};
+
+}  // namespace
+
+ConfigNode ParseYaml(const std::string& text, const std::string& source,
+                     std::vector<ConfigProblem>* problems) {
+  const SourceMark start{source, 1, 1};
+  std::vector<YAML::Node> documents;
+  try {
+    documents = YAML::LoadAll(text);
+  } catch (const YAML::Exception& error) {
+    // yaml-cpp marks are 0-based.
+    SourceMark mark{source, 0, 0};
+    if (!error.mark.is_null() && error.mark.line >= 0) {
+      mark.line = error.mark.line + 1;
+      mark.column = error.mark.column + 1;
+    }
+    problems->push_back({mark, "", "YAML syntax error: " + error.msg});
+    ConfigNode null_node;
+    null_node.mark = start;
+    return null_node;
+  }
+
+  // One document per configuration.
+  if (documents.size() > 1) {
+    Converter converter(source, problems);
+    problems->push_back({converter.Mark(documents[1].Mark(), start), "",
+                         "expected one YAML document (found " +
+                             std::to_string(documents.size()) + ")"});
+  }
+  if (documents.empty()) {
+    ConfigNode null_node;
+    null_node.mark = start;
+    return null_node;
+  }
+  Converter converter(source, problems);
+  return converter.Convert(documents.front(), start, 0);
+}
+
+}  // namespace mjslam::config

@@ -1,0 +1,58 @@
+#include "sim/sim_params.h"
+
+#include "common/angles.h"
+
+namespace mjslam::sim {
+
+std::vector<ParamProblem> SimParams::Validate() const {
+  ParamChecker check;
+  // 0.01 s is half the contact time constant (solref 0.02 s): the upper limit
+  // at which MuJoCo's soft contacts stay stable.
+  check.InRange("timestep_s", timestep_s, 1e-4, 0.01);
+  check.InRange("settle_time_s", settle_time_s, 0.0, 10.0);
+  return check.problems();
+}
+
+std::vector<ParamProblem> RobotParams::Validate() const {
+  ParamChecker check;
+  check.Positive("control_point_offset_m", control_point_offset_m);
+  check.Positive("wheel_radius_m", wheel_radius_m);
+  check.Positive("axle_track_m", axle_track_m);
+  check.Positive("max_wheel_speed_radps", max_wheel_speed_radps);
+  check.Positive("max_linear_speed_mps", max_linear_speed_mps);
+  check.Positive("max_angular_speed_radps", max_angular_speed_radps);
+  return check.problems();
+}
+
+double LaserParams::AngleMinRad() const { return -0.5 * DegToRad(fov_deg); }
+
+double LaserParams::AngleIncrementRad() const {
+  return num_beams > 1 ? DegToRad(fov_deg) / (num_beams - 1) : 0.0;
+}
+
+std::vector<ParamProblem> LaserParams::Validate() const {
+  ParamChecker check;
+  check.InRange("num_beams", num_beams, 2, 100000);
+  check.Require(fov_deg > 0.0 && fov_deg <= 360.0, "fov_deg", fov_deg,
+                "a value in (0, 360]");
+  check.Positive("max_range_m", max_range_m);
+  check.Positive("rate_hz", rate_hz);
+  check.NonNegative("range_noise_std_m", range_noise_std_m);
+  check.Require(range_bias_m > -max_range_m && range_bias_m < max_range_m,
+                "range_bias_m", range_bias_m,
+                "a value in (-max_range_m, max_range_m)");
+  check.NonNegative("angle_jitter_std_deg", angle_jitter_std_deg);
+  check.InRange("dropout_probability", dropout_probability, 0.0, 1.0);
+  return check.problems();
+}
+
+std::vector<ParamProblem> OdometryParams::Validate() const {
+  ParamChecker check;
+  check.Positive("ticks_per_wheel_revolution", ticks_per_wheel_revolution);
+  check.NonNegative("slip_std_fraction", slip_std_fraction);
+  check.InRange("wheel_radius_error_std_fraction", wheel_radius_error_std_fraction,
+                0.0, 0.2);
+  return check.problems();
+}
+
+}  // namespace mjslam::sim

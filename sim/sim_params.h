@@ -1,0 +1,128 @@
+#pragma once
+
+#include <vector>
+
+#include "common/params.h"
+
+namespace mjslam::sim {
+
+/// Physics settings of the MuJoCo scene (the robot model's <option> holds the
+/// rest: integrator, solver, cone).
+struct SimParams {
+  /// Physics timestep, seconds. Overrides the model's <option timestep>. The
+  /// contact solref time constant (0.02 s) must stay >= 2 timesteps.
+  double timestep_s = 0.002;
+  /// Time the robot rests on the floor, wheels held still, before time 0 of
+  /// the run (contacts settle; the clock is then reset to 0), seconds.
+  double settle_time_s = 0.3;
+
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit(MJSLAM_NVP(timestep_s));
+    a->Visit(MJSLAM_NVP(settle_time_s));
+  }
+  std::vector<ParamProblem> Validate() const;
+  void ValidateOrThrow() const { ThrowIfProblems(Validate()); }
+};
+
+/// The differential-drive Pioneer 3-DX as the controllers and the odometry
+/// see it. Frame R is the paper's point of control h: on the centre line,
+/// `control_point_offset_m` ahead of the axle centre A. Sources of every value:
+/// models/README.md. `wheel_radius_m` and `axle_track_m` must agree with the
+/// MJCF model (the Simulator checks them to 1 mm and throws otherwise).
+struct RobotParams {
+  /// Offset `a` of the point of control h (frame R) ahead of the axle centre,
+  /// metres (> 0: it is what makes the kinematics of h invertible).
+  double control_point_offset_m = 0.2;
+  /// Drive wheel radius, metres (195 mm wheels).
+  double wheel_radius_m = 0.0975;
+  /// Distance between the two drive wheels' contact points, metres.
+  double axle_track_m = 0.33;
+  /// Largest wheel speed the motors reach, rad/s (1.2 m/s / 0.0975 m).
+  double max_wheel_speed_radps = 12.3077;
+  /// Largest forward/backward speed of the axle centre, m/s.
+  double max_linear_speed_mps = 1.2;
+  /// Largest yaw rate, rad/s (300 deg/s).
+  double max_angular_speed_radps = 5.235988;
+
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit(MJSLAM_NVP(control_point_offset_m));
+    a->Visit(MJSLAM_NVP(wheel_radius_m));
+    a->Visit(MJSLAM_NVP(axle_track_m));
+    a->Visit(MJSLAM_NVP(max_wheel_speed_radps));
+    a->Visit(MJSLAM_NVP(max_linear_speed_mps));
+    a->Visit(MJSLAM_NVP(max_angular_speed_radps));
+  }
+  std::vector<ParamProblem> Validate() const;
+  void ValidateOrThrow() const { ThrowIfProblems(Validate()); }
+};
+
+/// The SICK LMS200 emulation: beam layout, rate, and the noise model applied
+/// after the exact cast (see sim/laser_noise.h). The noise fields are kept
+/// flat (laser.range_noise_std_m, not laser.noise.range_noise_std_m) so they
+/// are easy to set from the command line.
+struct LaserParams {
+  /// Number of beams, evenly spread over `fov_deg` (both ends included).
+  int num_beams = 181;
+  /// Field of view, degrees, centred on the x axis of the laser frame S:
+  /// beam i is at -fov/2 + i * fov / (num_beams - 1).
+  double fov_deg = 180.0;
+  /// Maximum range, metres; a beam with no echo within it reports exactly this.
+  double max_range_m = 30.0;
+  /// Scan rate, Hz. The caller casts at this rate, never on every physics step.
+  double rate_hz = 10.0;
+  /// Standard deviation of the Gaussian range noise, metres.
+  double range_noise_std_m = 0.005;
+  /// Constant range bias added to every echo, metres.
+  double range_bias_m = 0.0;
+  /// Standard deviation of the per-beam angular jitter, degrees: the beam is
+  /// cast at its nominal angle plus this error, but reported at the nominal one.
+  double angle_jitter_std_deg = 0.0;
+  /// Probability that a beam loses its echo (reported as no-return at max range).
+  double dropout_probability = 0.0;
+
+  /// Bearing of beam 0 in S, radians.
+  double AngleMinRad() const;
+  /// Angle between consecutive beams, radians.
+  double AngleIncrementRad() const;
+
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit(MJSLAM_NVP(num_beams));
+    a->Visit(MJSLAM_NVP(fov_deg));
+    a->Visit(MJSLAM_NVP(max_range_m));
+    a->Visit(MJSLAM_NVP(rate_hz));
+    a->Visit(MJSLAM_NVP(range_noise_std_m));
+    a->Visit(MJSLAM_NVP(range_bias_m));
+    a->Visit(MJSLAM_NVP(angle_jitter_std_deg));
+    a->Visit(MJSLAM_NVP(dropout_probability));
+  }
+  std::vector<ParamProblem> Validate() const;
+  void ValidateOrThrow() const { ThrowIfProblems(Validate()); }
+};
+
+/// Wheel encoders and their error model (see sim/wheel_odometry.h).
+struct OdometryParams {
+  /// Encoder counts per wheel revolution: 500-line encoders read in
+  /// quadrature (x4) through the 38.3:1 gearbox = 76600 (models/README.md).
+  int ticks_per_wheel_revolution = 76600;
+  /// Random slip: standard deviation of a wheel's travel error after 1 m of
+  /// travel, as a fraction of that metre. The variance grows linearly with
+  /// the distance rolled, so the result does not depend on the update rate.
+  double slip_std_fraction = 0.005;
+  /// Systematic error: each wheel's effective radius differs from the nominal
+  /// one by a factor 1 + e, e drawn once per run from N(0, this).
+  double wheel_radius_error_std_fraction = 0.0;
+
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit(MJSLAM_NVP(ticks_per_wheel_revolution));
+    a->Visit(MJSLAM_NVP(slip_std_fraction));
+    a->Visit(MJSLAM_NVP(wheel_radius_error_std_fraction));
+  }
+  std::vector<ParamProblem> Validate() const;
+  void ValidateOrThrow() const { ThrowIfProblems(Validate()); }
+};
+
+}  // namespace mjslam::sim

@@ -1,0 +1,98 @@
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <gtest/gtest.h>
+
+#include "app/csv_reader.h"
+#include "app/csv_writer.h"
+
+namespace mjslam::app {
+namespace {
+
+std::string TempPath(const std::string& name) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "mjslam_csv_test";
+  std::filesystem::create_directories(dir);
+  return (dir / name).string();
+}
+
+TEST(CsvTest, DoublesRoundTripExactly) {
+  const std::string path = TempPath("round_trip.csv");
+  const std::vector<double> values = {0.1, 1.0 / 3.0, -2.5e-300, 123456789.123456789, 0.0};
+  {
+    CsvWriter writer(path, {"a", "b"});
+    for (const double v : values) {
+      writer.Add(v);
+      writer.Add(-v);
+      writer.EndRow();
+    }
+  }
+  const CsvTable table = ReadCsv(path);
+  ASSERT_EQ(table.columns, (std::vector<std::string>{"a", "b"}));
+  ASSERT_EQ(table.rows.size(), values.size());
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    EXPECT_EQ(table.rows[i][0], values[i]);
+    EXPECT_EQ(table.rows[i][1], -values[i]);
+  }
+  EXPECT_EQ(table.ColumnIndex("b"), 1);
+  EXPECT_THROW(table.ColumnIndex("c"), std::runtime_error);
+}
+
+TEST(CsvTest, UnflushedRowsAreWholeAfterFlush) {
+  const std::string path = TempPath("flush.csv");
+  CsvWriter writer(path, {"x"});
+  writer.Add(1.0);
+  writer.EndRow();
+  writer.Flush();
+  writer.Add(2.0);  // a row in progress is not written
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  EXPECT_EQ(text.str(), "x\n1\n");
+  writer.EndRow();
+}
+
+TEST(CsvTest, EmptyFieldsReadAsNan) {
+  const std::string path = TempPath("empty.csv");
+  {
+    CsvWriter writer(path, {"a", "b", "c"});
+    writer.Add(1);
+    writer.AddEmpty();
+    writer.AddEmpty();
+    writer.EndRow();
+  }
+  const CsvTable table = ReadCsv(path);
+  ASSERT_EQ(table.rows.size(), 1u);
+  EXPECT_EQ(table.rows[0][0], 1.0);
+  EXPECT_TRUE(std::isnan(table.rows[0][1]));
+  EXPECT_TRUE(std::isnan(table.rows[0][2]));
+}
+
+TEST(CsvTest, BadInputNamesFileLineAndColumn) {
+  const std::string path = TempPath("bad.csv");
+  std::ofstream(path) << "t,x\n0,1\n0.1,abc\n";
+  try {
+    ReadCsv(path);
+    FAIL() << "expected an error";
+  } catch (const std::runtime_error& error) {
+    EXPECT_NE(std::string(error.what()).find(path + ":3: column x"), std::string::npos)
+        << error.what();
+    EXPECT_NE(std::string(error.what()).find("abc"), std::string::npos);
+  }
+  std::ofstream(path) << "t,x\n0,1,2\n";
+  EXPECT_THROW(ReadCsv(path), std::runtime_error);
+  EXPECT_THROW(ReadCsv(TempPath("missing.csv")), std::runtime_error);
+}
+
+TEST(CsvTest, UnwritableFileIsAnErrorNamingIt) {
+  try {
+    CsvWriter writer("/nonexistent-folder/x.csv", {"a"});
+    FAIL();
+  } catch (const std::runtime_error& error) {
+    EXPECT_NE(std::string(error.what()).find("/nonexistent-folder/x.csv"), std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace mjslam::app

@@ -1,0 +1,189 @@
+// The run directory as an interface: files, determinism, replay, interrupts.
+#include <signal.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <thread>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "tests/integration/run_helpers.h"
+
+namespace mjslam::testing {
+namespace {
+
+using app::CsvTable;
+using app::ReadCsv;
+
+// A short run of the default config into `dir`.
+int ShortRun(const std::string& dir, int seed, const std::string& extra = "") {
+  return Shell(Program() + " run --quiet --config " + DefaultConfig() + " --duration 12 --seed " +
+               std::to_string(seed) + " --out " + dir + " " + extra + " 2> " + dir + ".log");
+}
+
+// Same rows bit for bit (NaN equal to NaN).
+void ExpectSameTable(const CsvTable& a, const CsvTable& b) {
+  ASSERT_EQ(a.columns, b.columns);
+  ASSERT_EQ(a.rows.size(), b.rows.size());
+  for (std::size_t r = 0; r < a.rows.size(); ++r) {
+    for (std::size_t c = 0; c < a.columns.size(); ++c) {
+      const double x = a.rows[r][c];
+      const double y = b.rows[r][c];
+      if (std::isnan(x) && std::isnan(y)) continue;
+      ASSERT_EQ(x, y) << a.path << " row " << r + 1 << " column " << a.columns[c];
+    }
+  }
+}
+
+class RunFilesTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    first_ = new std::string(FreshDir("first"));
+    second_ = new std::string(FreshDir("second"));
+    ASSERT_EQ(ShortRun(*first_, 5), 0) << ReadText(*first_ + ".log");
+    ASSERT_EQ(ShortRun(*second_, 5), 0) << ReadText(*second_ + ".log");
+  }
+  static void TearDownTestSuite() {
+    delete first_;
+    delete second_;
+  }
+  static std::string* first_;
+  static std::string* second_;
+};
+std::string* RunFilesTest::first_ = nullptr;
+std::string* RunFilesTest::second_ = nullptr;
+
+TEST_F(RunFilesTest, WritesEveryFileWithTheDocumentedColumns) {
+  const CsvTable trajectory = ReadCsv(*first_ + "/trajectory.csv");
+  const std::vector<std::string> head = {"t",      "true_x",  "true_y", "true_th", "odom_x",
+                                         "odom_y", "odom_th", "cmd_v",  "cmd_w"};
+  ASSERT_GE(trajectory.columns.size(), head.size());
+  EXPECT_TRUE(std::equal(head.begin(), head.end(), trajectory.columns.begin()));
+  for (const std::string f : {"classical", "selective"}) {
+    for (const std::string c : {"x", "y", "th", "pxx", "pxy", "pxth", "pyy", "pyth", "pthth",
+                                "nfeat", "nmatched", "nupdated", "us"}) {
+      EXPECT_NO_THROW(trajectory.ColumnIndex(f + "_" + c)) << f + "_" + c;
+    }
+  }
+  // 12 s at 10 Hz: steps at t = 0, 0.1, ..., 12.
+  ASSERT_EQ(trajectory.rows.size(), 121u);
+  EXPECT_NEAR(trajectory.rows.back()[0], 12.0, 1e-9);
+
+  const CsvTable scans = ReadCsv(*first_ + "/scans.csv");
+  ASSERT_EQ(scans.columns.size(), 4u + 181u);
+  EXPECT_EQ(scans.columns[4], "r0");
+  EXPECT_EQ(scans.columns.back(), "r180");
+  EXPECT_EQ(scans.rows.size(), 121u);
+  for (const std::vector<double>& row : scans.rows) {
+    for (std::size_t i = 4; i < row.size(); ++i) {
+      ASSERT_GE(row[i], 0.0);
+      ASSERT_LE(row[i], 30.0);
+    }
+  }
+
+  for (const std::string map : {"map_classical.csv", "map_selective.csv"}) {
+    const std::string text = ReadText(*first_ + "/" + map);
+    EXPECT_EQ(text.substr(0, text.find('\n')), "id,type,p0,p1,c00,c01,c11,ax,ay,bx,by");
+  }
+  const nlohmann::json manifest = nlohmann::json::parse(ReadText(*first_ + "/manifest.json"));
+  EXPECT_EQ(manifest["status"], "completed");
+  EXPECT_EQ(manifest["seed"], 5);
+  EXPECT_EQ(manifest["mujoco_version"], "2.2.2");
+  EXPECT_EQ(manifest["world_hash"].get<std::string>().substr(0, 8), "fnv1a64:");
+  EXPECT_FALSE(manifest["end_time"].is_null());
+  EXPECT_NE(ReadText(*first_ + "/config.yaml").find("seed: 5"), std::string::npos);
+}
+
+TEST_F(RunFilesTest, SameSeedGivesIdenticalFiles) {
+  for (const std::string file : {"scans.csv", "map_classical.csv", "map_selective.csv",
+                                 "config.yaml"}) {
+    EXPECT_EQ(ReadText(*first_ + "/" + file), ReadText(*second_ + "/" + file)) << file;
+  }
+  // Trajectories agree bit for bit except the measured processing times.
+  ExpectSameTable(DropColumns(ReadCsv(*first_ + "/trajectory.csv"), "_us"),
+                  DropColumns(ReadCsv(*second_ + "/trajectory.csv"), "_us"));
+  nlohmann::json a = nlohmann::json::parse(ReadText(*first_ + "/manifest.json"));
+  nlohmann::json b = nlohmann::json::parse(ReadText(*second_ + "/manifest.json"));
+  for (const char* key : {"start_time", "end_time", "command_line"}) {
+    a.erase(key);
+    b.erase(key);
+  }
+  EXPECT_EQ(a, b);
+}
+
+TEST_F(RunFilesTest, AnotherSeedGivesOtherNoise) {
+  const std::string dir = FreshDir("other_seed");
+  ASSERT_EQ(ShortRun(dir, 6), 0) << ReadText(dir + ".log");
+  EXPECT_NE(ReadText(*first_ + "/scans.csv"), ReadText(dir + "/scans.csv"));
+}
+
+TEST_F(RunFilesTest, ReplayReproducesTheFilters) {
+  const std::string dir = FreshDir("replay");
+  ASSERT_EQ(Shell(Program() + " replay --scans " + *first_ + "/scans.csv --config " +
+                  *first_ + "/config.yaml --out " + dir + " 2> " + dir + ".log"),
+            0)
+      << ReadText(dir + ".log");
+  ExpectSameTable(DropColumns(ReadCsv(*first_ + "/trajectory.csv"), "_us"),
+                  DropColumns(ReadCsv(dir + "/trajectory.csv"), "_us"));
+  EXPECT_EQ(ReadText(*first_ + "/map_selective.csv"), ReadText(dir + "/map_selective.csv"));
+  EXPECT_EQ(ReadText(*first_ + "/map_classical.csv"), ReadText(dir + "/map_classical.csv"));
+}
+
+TEST(RunFailureTest, InterruptedRunKeepsCompleteRowsAndSaysSo) {
+  const std::string dir = FreshDir("interrupted");
+  const pid_t child = fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    const std::string program = Program();
+    const std::string config = DefaultConfig();
+    execl(program.c_str(), program.c_str(), "run", "--quiet", "--config", config.c_str(),
+          "--duration", "100000", "--out", dir.c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  // Wait until rows have reached the disk, then interrupt.
+  const std::string trajectory = dir + "/trajectory.csv";
+  for (int i = 0; i < 600; ++i) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(100));
+    if (std::filesystem::exists(trajectory) && std::filesystem::file_size(trajectory) > 200000) {
+      break;
+    }
+  }
+  kill(child, SIGINT);
+  int status = 0;
+  waitpid(child, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 130);
+  const nlohmann::json manifest = nlohmann::json::parse(ReadText(dir + "/manifest.json"));
+  EXPECT_EQ(manifest["status"], "interrupted");
+  const CsvTable rows = ReadCsv(trajectory);  // throws on a partial row
+  EXPECT_GT(rows.rows.size(), 100u);
+  EXPECT_EQ(manifest["steps"].get<std::size_t>(), rows.rows.size());
+  EXPECT_NO_THROW(ReadCsv(dir + "/scans.csv"));
+}
+
+TEST(RunFailureTest, MissingWorldIsAClearErrorAndNoRunIsStarted) {
+  const std::string dir = FreshDir("missing_world");
+  const int status = Shell(Program() + " run --quiet --config " + DefaultConfig() +
+                           " --world /no/such/world.xml --out " + dir + "/run 2> " + dir +
+                           "/err.log");
+  EXPECT_EQ(status, 1);
+  EXPECT_NE(ReadText(dir + "/err.log").find("/no/such/world.xml"), std::string::npos)
+      << ReadText(dir + "/err.log");
+}
+
+TEST(RunFailureTest, BadOverrideNamesTheKeyAndValue) {
+  const std::string dir = FreshDir("bad_override");
+  const int status = Shell(Program() + " run --quiet --config " + DefaultConfig() +
+                           " --set laser.max_range_m=-4 --out " + dir + "/run 2> " + dir +
+                           "/err.log");
+  EXPECT_EQ(status, 1);
+  const std::string err = ReadText(dir + "/err.log");
+  EXPECT_NE(err.find("laser.max_range_m"), std::string::npos) << err;
+  EXPECT_NE(err.find("-4"), std::string::npos) << err;
+  EXPECT_FALSE(std::filesystem::exists(dir + "/run/trajectory.csv"));
+}
+
+}  // namespace
+}  // namespace mjslam::testing

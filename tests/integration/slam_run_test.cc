@@ -1,0 +1,109 @@
+// Both filters on a short seeded run of the default world: consistency bands,
+// covariance sanity and the selective filter's bound on updates.
+#include <cmath>
+
+#include <Eigen/Eigenvalues>
+#include <gtest/gtest.h>
+
+#include "common/angles.h"
+#include "tests/integration/run_helpers.h"
+
+namespace mjslam::testing {
+namespace {
+
+class SlamRunTest : public ::testing::Test {
+ protected:
+  // Seed 1, 60 s of the default world (the corridor loop) with the default
+  // config: MAX = 2 updates per step for the selective filter.
+  static void SetUpTestSuite() {
+    dir_ = new std::string(FreshDir("slam_run"));
+    ASSERT_EQ(Shell(Program() + " run --quiet --config " + DefaultConfig() +
+                    " --duration 60 --seed 1 --out " + *dir_ + " 2> " + *dir_ + ".log"),
+              0)
+        << ReadText(*dir_ + ".log");
+    table_ = new app::CsvTable(app::ReadCsv(*dir_ + "/trajectory.csv"));
+  }
+  static void TearDownTestSuite() {
+    delete table_;
+    delete dir_;
+  }
+  double Value(std::size_t row, const std::string& column) const {
+    return table_->rows[row][table_->ColumnIndex(column)];
+  }
+  static std::string* dir_;
+  static app::CsvTable* table_;
+};
+std::string* SlamRunTest::dir_ = nullptr;
+app::CsvTable* SlamRunTest::table_ = nullptr;
+
+TEST_F(SlamRunTest, PoseErrorsStayInsideTwoSigmaForNinetyPercentOfSteps) {
+  for (const std::string f : {"classical", "selective"}) {
+    int inside[3] = {0, 0, 0};
+    const std::size_t n = table_->rows.size();
+    for (std::size_t r = 0; r < n; ++r) {
+      const double error[3] = {Value(r, f + "_x") - Value(r, "true_x"),
+                               Value(r, f + "_y") - Value(r, "true_y"),
+                               WrapAngle(Value(r, f + "_th") - Value(r, "true_th"))};
+      const double variance[3] = {Value(r, f + "_pxx"), Value(r, f + "_pyy"),
+                                  Value(r, f + "_pthth")};
+      for (int k = 0; k < 3; ++k) {
+        // The known start has zero covariance and zero error: count it inside.
+        if (std::abs(error[k]) <= 2.0 * std::sqrt(variance[k]) + 1e-12) ++inside[k];
+      }
+    }
+    for (int k = 0; k < 3; ++k) {
+      const double fraction = static_cast<double>(inside[k]) / n;
+      std::printf("%s component %d: %.3f of %zu steps inside 2 sigma\n", f.c_str(), k, fraction, n);
+      EXPECT_GE(fraction, 0.90) << f << " component " << k;
+    }
+  }
+}
+
+TEST_F(SlamRunTest, PoseCovarianceIsSymmetricPositiveSemiDefinite) {
+  for (const std::string f : {"classical", "selective"}) {
+    for (std::size_t r = 0; r < table_->rows.size(); ++r) {
+      Eigen::Matrix3d P;
+      P << Value(r, f + "_pxx"), Value(r, f + "_pxy"), Value(r, f + "_pxth"),
+          Value(r, f + "_pxy"), Value(r, f + "_pyy"), Value(r, f + "_pyth"),
+          Value(r, f + "_pxth"), Value(r, f + "_pyth"), Value(r, f + "_pthth");
+      const double smallest = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(P).eigenvalues()(0);
+      ASSERT_GE(smallest, -1e-12 * std::max(1.0, P.norm())) << f << " row " << r + 1;
+    }
+  }
+}
+
+TEST_F(SlamRunTest, SelectiveUsesAtMostMaxObservationsClassicalUsesAll) {
+  int selective_limited = 0;
+  int classical_updates = 0;
+  for (std::size_t r = 0; r < table_->rows.size(); ++r) {
+    const double matched = Value(r, "selective_nmatched");
+    const double updated = Value(r, "selective_nupdated");
+    ASSERT_LE(updated, 2.0) << "row " << r + 1;
+    ASSERT_EQ(updated, std::min(matched, 2.0)) << "row " << r + 1;
+    if (matched > 2.0) ++selective_limited;
+    ASSERT_EQ(Value(r, "classical_nupdated"), Value(r, "classical_nmatched")) << "row " << r + 1;
+    classical_updates += static_cast<int>(Value(r, "classical_nupdated"));
+  }
+  // The run must exercise the selection, or the test above proves nothing.
+  EXPECT_GT(selective_limited, 50);
+  EXPECT_GT(classical_updates, 500);
+  EXPECT_GT(Value(table_->rows.size() - 1, "classical_nfeat"), 10.0);
+}
+
+TEST_F(SlamRunTest, MapCovariancesArePositiveDefinite) {
+  for (const std::string f : {"classical", "selective"}) {
+    const app::CsvTable map = app::ReadCsv(*dir_ + "/map_" + f + ".csv", {"type"});
+    ASSERT_GT(map.rows.size(), 10u);
+    for (const std::vector<double>& row : map.rows) {
+      const double c00 = row[map.ColumnIndex("c00")];
+      const double c01 = row[map.ColumnIndex("c01")];
+      const double c11 = row[map.ColumnIndex("c11")];
+      EXPECT_GT(c00, 0.0);
+      EXPECT_GT(c11, 0.0);
+      EXPECT_GT(c00 * c11 - c01 * c01, 0.0);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace mjslam::testing

@@ -1,0 +1,100 @@
+// Keeps the layering of the style guide honest: which folder may include what.
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+namespace mjslam {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Project folders that hold code.
+const std::set<std::string> kCodeFolders = {"common", "config", "sim", "slam", "explorer",
+                                            "eval", "renders", "app"};
+
+// What each folder may include from the project and from outside.
+struct Rule {
+  std::set<std::string> project;  // project folders it may include
+  bool mujoco = false;
+  bool yaml = false;
+  bool gl = false;
+  bool files_and_printing = true;  // <fstream>, <iostream>
+};
+
+Rule RuleFor(const std::string& folder) {
+  if (folder == "common") return {{"common"}, false, false, false, false};
+  if (folder == "slam") return {{"common", "slam"}, false, false, false, false};
+  if (folder == "explorer") return {{"common", "explorer"}, false, false, false, false};
+  if (folder == "eval") return {{"common", "eval"}, false, false, false, false};
+  if (folder == "config") return {{"common", "config"}, false, true, false, true};
+  if (folder == "sim") return {{"common", "sim"}, true, false, false, true};
+  if (folder == "renders") return {kCodeFolders, true, false, true, true};
+  return {kCodeFolders, false, false, false, true};  // app
+}
+
+// The violations of `rule` in the text of one source file.
+std::vector<std::string> Violations(const std::string& text, const Rule& rule) {
+  std::vector<std::string> found;
+  static const std::regex kInclude(R"(^\s*#\s*include\s*[<"]([^>"]+)[>"])");
+  std::istringstream lines(text);
+  std::string line;
+  while (std::getline(lines, line)) {
+    std::smatch match;
+    if (!std::regex_search(line, match, kInclude)) continue;
+    const std::string header = match[1];
+    const std::string top = header.substr(0, header.find('/'));
+    const bool nested = header.find('/') != std::string::npos;
+    if (nested && kCodeFolders.count(top) > 0 && rule.project.count(top) == 0) {
+      found.push_back(header);
+    } else if (top == "mujoco" && !rule.mujoco) {
+      found.push_back(header);
+    } else if (top == "yaml-cpp" && !rule.yaml) {
+      found.push_back(header);
+    } else if ((top == "GL" || top == "EGL") && !rule.gl) {
+      found.push_back(header);
+    } else if ((header == "fstream" || header == "iostream") && !rule.files_and_printing) {
+      found.push_back(header);
+    }
+  }
+  return found;
+}
+
+TEST(LayeringTest, DetectsForbiddenIncludes) {
+  const std::string text =
+      "#include <mujoco/mujoco.h>\n#include \"explorer/waypoint_driver.h\"\n"
+      "#include <yaml-cpp/yaml.h>\n#include <GL/osmesa.h>\n#include <fstream>\n"
+      "#include \"common/pose2.h\"\n#include <Eigen/Core>\n";
+  EXPECT_EQ(Violations(text, RuleFor("slam")).size(), 5u);
+  EXPECT_EQ(Violations(text, RuleFor("renders")).size(), 1u);  // yaml-cpp
+  EXPECT_TRUE(Violations("#include \"slam/ekf_slam.h\"\n", RuleFor("app")).empty());
+}
+
+TEST(LayeringTest, EveryFolderIncludesOnlyWhatItMay) {
+  const fs::path root(MJSLAM_SOURCE_DIR);
+  int files = 0;
+  for (const std::string& folder : kCodeFolders) {
+    if (!fs::exists(root / folder)) continue;
+    for (const auto& entry : fs::recursive_directory_iterator(root / folder)) {
+      const std::string ext = entry.path().extension().string();
+      if (ext != ".h" && ext != ".cc") continue;
+      std::ifstream in(entry.path());
+      std::stringstream text;
+      text << in.rdbuf();
+      ++files;
+      for (const std::string& header : Violations(text.str(), RuleFor(folder))) {
+        ADD_FAILURE() << entry.path() << " includes " << header << ", which " << folder
+                      << "/ may not";
+      }
+    }
+  }
+  EXPECT_GT(files, 10);
+}
+
+}  // namespace
+}  // namespace mjslam
