@@ -13,6 +13,7 @@
 #include "app/run.h"
 #include "app/run_config.h"
 #include "app/run_files.h"
+#include "config/config.h"
 
 namespace {
 
@@ -66,6 +67,12 @@ int main(int argc, char** argv) {
   replay->add_option("--out", out_dir, "Output directory")->required();
   replay->add_option("--set", overrides, "Override any config key")->type_name("KEY=VALUE");
 
+  // mjslam config
+  CLI::App* show_config =
+      cli.add_subcommand("config", "Print the resolved config (defaults, file, overrides) as YAML");
+  show_config->add_option("--config", config_path, "YAML config file")->capture_default_str();
+  show_config->add_option("--set", overrides, "Override any config key")->type_name("KEY=VALUE");
+
   CLI11_PARSE(cli, argc, argv);
 
   std::signal(SIGINT, RequestStop);
@@ -93,6 +100,11 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "%s: %s after %d steps (%.1f s simulated)\n", options.out_dir.c_str(),
                    result.status.c_str(), result.steps, result.sim_time_s);
       return result.status == "completed" ? 0 : 130;
+    }
+    if (show_config->parsed()) {
+      std::fputs(mjslam::config::ToYaml(mjslam::app::LoadRunConfig(config_path, overrides)).c_str(),
+                 stdout);
+      return 0;
     }
     if (replay->parsed()) {
       const RunConfig config = mjslam::app::LoadRunConfig(config_path, overrides);

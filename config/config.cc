@@ -1,5 +1,6 @@
 #include "config/config.h"
 
+#include <algorithm>
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
@@ -131,7 +132,6 @@ void ApplyOverrides(const std::vector<std::string>& overrides, ConfigNode* root,
         std::string message = problem.message;
         const std::string syntax = "YAML syntax error: ";
         if (message.compare(0, syntax.size(), syntax) == 0) message.erase(0, syntax.size());
-        if (problem.mark.line > 0) message += " (column " + std::to_string(problem.mark.column) + ")";
         problems->push_back({mark, key, "invalid YAML value: " + message});
       }
       continue;
@@ -156,6 +156,24 @@ void ApplyOverrides(const std::vector<std::string>& overrides, ConfigNode* root,
       node->entries.push_back(ConfigEntry{parts.back(), mark, std::move(value)});
     }
   }
+}
+
+void SortProblems(const std::string& source, std::vector<ConfigProblem>* problems) {
+  // Text order first, then defaults, then options (in option order).
+  const auto rank = [&source](const ConfigProblem& problem) {
+    if (problem.mark.source == source && problem.mark.line > 0) return 0;
+    if (problem.mark.source == source) return 1;
+    return 2;
+  };
+  std::stable_sort(problems->begin(), problems->end(),
+                   [&rank](const ConfigProblem& a, const ConfigProblem& b) {
+                     const int rank_a = rank(a);
+                     const int rank_b = rank(b);
+                     if (rank_a != rank_b) return rank_a < rank_b;
+                     if (rank_a != 0) return false;
+                     if (a.mark.line != b.mark.line) return a.mark.line < b.mark.line;
+                     return a.mark.column < b.mark.column;
+                   });
 }
 
 void AddValidationProblems(const std::vector<ParamProblem>& validation,

@@ -42,6 +42,11 @@ void AddValidationProblems(const std::vector<ParamProblem>& validation,
                            const MarkTable& marks, const std::string& source,
                            std::vector<ConfigProblem>* problems);
 
+/// Orders problems for reading: those with a line in `source` by line and
+/// column, then those naming `source` alone (defaults), then the `--set`
+/// ones in the order found (stable).
+void SortProblems(const std::string& source, std::vector<ConfigProblem>* problems);
+
 }  // namespace internal
 
 /// Reads `yaml_text` (named `source_name` in messages, e.g. the file path)
@@ -49,7 +54,8 @@ void AddValidationProblems(const std::vector<ParamProblem>& validation,
 /// keep their defaults. Then applies `overrides` ("dotted.key=value", from
 /// `--set` options; the value is YAML, e.g. "driver.waypoints=[[0,0],[1,2]]")
 /// and runs `T::Validate()` (when T has one).
-/// Throws ConfigError listing every problem at once: YAML syntax errors,
+/// Throws ConfigError listing every problem at once (in text order, then
+/// defaults, then `--set` options): YAML syntax errors,
 /// unknown keys (with the known keys of that level), duplicate keys, wrong
 /// types, out-of-range values, bad `--set` options. An empty text gives the
 /// defaults (validated).
@@ -76,7 +82,10 @@ T LoadConfigString(const std::string& yaml_text, const std::string& source_name,
   if constexpr (internal::HasValidate<T>::value) {
     internal::AddValidationProblems(params.Validate(), marks, source_name, &problems);
   }
-  if (!problems.empty()) throw ConfigError(std::move(problems));
+  if (!problems.empty()) {
+    internal::SortProblems(source_name, &problems);
+    throw ConfigError(std::move(problems));
+  }
   return params;
 }
 

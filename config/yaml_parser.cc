@@ -58,8 +58,8 @@ class Converter {
         // Iterate the pairs: duplicate keys are all kept, in order.
         ConfigNode out = MapNode(mark);
         for (auto it = node.begin(); it != node.end(); ++it) {
-          const YAML::Node& key = it->first;
-          const YAML::Node& value = it->second;
+          const YAML::Node key = it->first;  // copies: it-> is a temporary
+          const YAML::Node value = it->second;
           const SourceMark key_mark = Mark(key.Mark(), mark);
           if (!key.IsScalar()) {
             problems_->push_back({key_mark, "", "expected a plain key (got a null, map or sequence key)"});

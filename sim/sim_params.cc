@@ -10,6 +10,8 @@ std::vector<ParamProblem> SimParams::Validate() const {
   // at which MuJoCo's soft contacts stay stable.
   check.InRange("timestep_s", timestep_s, 1e-4, 0.01);
   check.InRange("settle_time_s", settle_time_s, 0.0, 10.0);
+  check.Positive("wheel_speed_kp_nms_per_rad", wheel_speed_kp_nms_per_rad);
+  check.NonNegative("wheel_speed_ki_nm_per_rad", wheel_speed_ki_nm_per_rad);
   return check.problems();
 }
 

@@ -7,7 +7,11 @@
 namespace mjslam::sim {
 
 /// Physics settings of the MuJoCo scene (the robot model's <option> holds the
-/// rest: integrator, solver, cone).
+/// rest: integrator, solver, cone) and of the emulated wheel-speed controller:
+/// the Pioneer's firmware runs a PID loop on encoder speeds; here each wheel
+/// motor gets torque = kp e + ki integral(e), e = set point - wheel speed,
+/// clamped to the actuator's ctrlrange (with conditional integration, so the
+/// integral does not wind up while the torque is saturated).
 struct SimParams {
   /// Physics timestep, seconds. Overrides the model's <option timestep>. The
   /// contact solref time constant (0.02 s) must stay >= 2 timesteps.
@@ -15,11 +19,20 @@ struct SimParams {
   /// Time the robot rests on the floor, wheels held still, before time 0 of
   /// the run (contacts settle; the clock is then reset to 0), seconds.
   double settle_time_s = 0.3;
+  /// Proportional gain of each wheel's speed controller, N m per rad/s.
+  /// With explicit Euler it must stay below about 2 x (wheel inertia +
+  /// armature) / timestep (the Simulator checks kp dt / I < 1).
+  double wheel_speed_kp_nms_per_rad = 5.0;
+  /// Integral gain of each wheel's speed controller, N m per rad of
+  /// accumulated speed error (removes the steady-state error under load).
+  double wheel_speed_ki_nm_per_rad = 50.0;
 
   template <typename Archive>
   void Serialize(Archive* a) {
     a->Visit(MJSLAM_NVP(timestep_s));
     a->Visit(MJSLAM_NVP(settle_time_s));
+    a->Visit(MJSLAM_NVP(wheel_speed_kp_nms_per_rad));
+    a->Visit(MJSLAM_NVP(wheel_speed_ki_nm_per_rad));
   }
   std::vector<ParamProblem> Validate() const;
   void ValidateOrThrow() const { ThrowIfProblems(Validate()); }

@@ -1,0 +1,272 @@
+#include "slam/ekf_slam.h"
+
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include "common/angles.h"
+#include "common/params.h"
+#include "slam/data_association.h"
+#include "slam/motion_model.h"
+
+namespace mjslam::slam {
+namespace {
+
+const EkfParams& Validated(const EkfParams& params) {
+  ThrowIfProblems(params.Validate(), "slam.ekf");
+  return params;
+}
+
+bool IsFinite(const Pose2& pose) {
+  return std::isfinite(pose.x) && std::isfinite(pose.y) && std::isfinite(pose.theta);
+}
+
+std::string PoseText(const Pose2& pose) {
+  return "(" + ValueText(pose.x) + ", " + ValueText(pose.y) + ", " + ValueText(pose.theta) + ")";
+}
+
+std::string MatrixText(const Eigen::Matrix2d& m) {
+  return "[" + ValueText(m(0, 0)) + ", " + ValueText(m(0, 1)) + "; " + ValueText(m(1, 0)) +
+         ", " + ValueText(m(1, 1)) + "]";
+}
+
+// Throws SlamInputError for `what` unless R is finite, symmetric and positive
+// definite; returns it exactly symmetric.
+Eigen::Matrix2d CheckedCovariance(const Eigen::Matrix2d& R, const std::string& what) {
+  const bool finite = R.allFinite();
+  const double asymmetry = std::abs(R(0, 1) - R(1, 0));
+  const double scale = std::max(std::abs(R(0, 0)), std::abs(R(1, 1)));
+  const Eigen::Matrix2d symmetric = 0.5 * (R + R.transpose());
+  const double det = symmetric(0, 0) * symmetric(1, 1) - symmetric(0, 1) * symmetric(1, 0);
+  if (!finite || asymmetry > 1e-9 * scale || !(symmetric(0, 0) > 0.0) || !(det > 0.0)) {
+    throw SlamInputError("EkfSlam::Step: " + what +
+                         ": expected a finite, symmetric, positive definite matrix (got " +
+                         MatrixText(R) + ")");
+  }
+  return symmetric;
+}
+
+void RequireFinite(double value, const std::string& what) {
+  if (!std::isfinite(value)) {
+    throw SlamInputError("EkfSlam::Step: " + what + ": expected a finite value (got " +
+                         ValueText(value) + ")");
+  }
+}
+
+}  // namespace
+
+EkfSlam::EkfSlam(const EkfParams& params, CorrectionMode mode, const Pose2& X_WR0,
+                 const Pose2& X_RS)
+    : params_(Validated(params)),
+      mode_(mode),
+      state_(Eigen::Vector3d(X_WR0.x, X_WR0.y, X_WR0.theta),
+             Eigen::Vector3d(params.initial_position_std_m * params.initial_position_std_m,
+                             params.initial_position_std_m * params.initial_position_std_m,
+                             params.initial_heading_std_rad * params.initial_heading_std_rad)
+                 .asDiagonal(),
+             X_RS),
+      gate_(ChiSquare2Quantile(params.gate_probability)),
+      new_feature_threshold_(ChiSquare2Quantile(params.new_feature_probability)) {
+  if (!IsFinite(X_WR0)) {
+    throw SlamInputError("EkfSlam: X_WR0: expected a finite pose (got " + PoseText(X_WR0) + ")");
+  }
+  if (!IsFinite(X_RS)) {
+    throw SlamInputError("EkfSlam: X_RS: expected a finite pose (got " + PoseText(X_RS) + ")");
+  }
+}
+
+Pose2 EkfSlam::X_WR() const {
+  const Eigen::Vector3d pose = state_.pose();
+  return Pose2(pose.x(), pose.y(), pose.z());
+}
+
+std::vector<EkfSlam::Observation> EkfSlam::CollectObservations(
+    const ScanFeatures& features) const {
+  std::vector<Observation> observations;
+  observations.reserve(features.lines.size() + features.corners.size());
+
+  // Lines, canonical, with the model-error noise added.
+  const Eigen::Matrix2d extra_line =
+      Eigen::Vector2d(params_.extra_line_rho_std_m * params_.extra_line_rho_std_m,
+                      params_.extra_line_alpha_std_rad * params_.extra_line_alpha_std_rad)
+          .asDiagonal();
+  for (std::size_t i = 0; i < features.lines.size(); ++i) {
+    const LineObservation& line = features.lines[i];
+    const std::string what = "features.lines[" + std::to_string(i) + "]";
+    RequireFinite(line.rho_m, what + ".rho_m");
+    RequireFinite(line.alpha_rad, what + ".alpha_rad");
+    if (!line.p_SA.allFinite() || !line.p_SB.allFinite()) {
+      throw SlamInputError("EkfSlam::Step: " + what + ".p_SA/p_SB: expected finite points");
+    }
+    Eigen::Matrix2d J;
+    Observation observation;
+    observation.type = FeatureType::kLine;
+    observation.z = CanonicalLine(Eigen::Vector2d(line.rho_m, line.alpha_rad), &J);
+    observation.R = J * CheckedCovariance(line.covariance + extra_line, what + ".covariance") *
+                    J.transpose();
+    observation.p_SA = line.p_SA;
+    observation.p_SB = line.p_SB;
+    observations.push_back(observation);
+  }
+
+  // Corners, likewise.
+  const Eigen::Matrix2d extra_corner =
+      Eigen::Vector2d(params_.extra_corner_range_std_m * params_.extra_corner_range_std_m,
+                      params_.extra_corner_bearing_std_rad * params_.extra_corner_bearing_std_rad)
+          .asDiagonal();
+  for (std::size_t i = 0; i < features.corners.size(); ++i) {
+    const CornerObservation& corner = features.corners[i];
+    const std::string what = "features.corners[" + std::to_string(i) + "]";
+    RequireFinite(corner.bearing_rad, what + ".bearing_rad");
+    if (!(corner.range_m > 0.0) || !std::isfinite(corner.range_m)) {
+      throw SlamInputError("EkfSlam::Step: " + what + ".range_m: expected a finite value > 0 (got " +
+                           ValueText(corner.range_m) + ")");
+    }
+    Observation observation;
+    observation.type = FeatureType::kCorner;
+    observation.z = Eigen::Vector2d(corner.range_m, WrapAngle(corner.bearing_rad));
+    observation.R = CheckedCovariance(corner.covariance + extra_corner, what + ".covariance");
+    observation.p_SA = corner.p_SC;
+    observation.p_SB = corner.p_SC;
+    observations.push_back(observation);
+  }
+  return observations;
+}
+
+Eigen::MatrixXd EkfSlam::MahalanobisDistances(const std::vector<Observation>& observations) const {
+  const int num_observations = static_cast<int>(observations.size());
+  Eigen::MatrixXd d2 = Eigen::MatrixXd::Constant(num_observations, state_.num_features(),
+                                                 std::numeric_limits<double>::infinity());
+  for (int k = 0; k < state_.num_features(); ++k) {
+    // The prediction and H P H^T depend on the feature only: once per feature.
+    const SlamState::Measurement m = state_.Measure(k);
+    if (!m.valid) continue;
+    for (int i = 0; i < num_observations; ++i) {
+      const Observation& observation = observations[i];
+      if (observation.type != state_.feature_type(k)) continue;
+      const Eigen::Vector2d nu = Innovation(observation.z, m.h);
+      const Eigen::Matrix2d S = m.HPHt + observation.R;
+      // nu^T S^-1 nu with the 2x2 inverse written out.
+      const double det = S(0, 0) * S(1, 1) - S(0, 1) * S(1, 0);
+      d2(i, k) = (S(1, 1) * nu.x() * nu.x() - (S(0, 1) + S(1, 0)) * nu.x() * nu.y() +
+                  S(0, 0) * nu.y() * nu.y()) /
+                 det;
+    }
+  }
+  return d2;
+}
+
+void EkfSlam::GrowSegment(int k, const Observation& observation) {
+  const Pose2 X_WS = X_WR() * state_.X_RS();
+  info_[k].segment = ExtendSegment(info_[k].segment, state_.feature(k), X_WS * observation.p_SA,
+                                   X_WS * observation.p_SB);
+}
+
+StepReport EkfSlam::Step(const SensorRecord& record, const ScanFeatures* features) {
+  // Everything is checked before anything changes.
+  if (!std::isfinite(record.dt_s) || record.dt_s < 0.0) {
+    throw SlamInputError("EkfSlam::Step: record.dt_s: expected a finite value >= 0 (got " +
+                         ValueText(record.dt_s) + ")");
+  }
+  const bool use_odometry = params_.input == "odometry";
+  MotionInput input;
+  if (use_odometry) {
+    if (!IsFinite(record.X_OR)) {
+      throw SlamInputError("EkfSlam::Step: record.X_OR: expected a finite pose (got " +
+                           PoseText(record.X_OR) + ")");
+    }
+    input = OdometryInput(X_OR_previous_, record.X_OR, params_.odometry_noise);
+  } else {
+    RequireFinite(record.command.v_mps, "record.command.v_mps");
+    RequireFinite(record.command.w_radps, "record.command.w_radps");
+    input = CommandInput(record.command, record.dt_s, params_.command_noise);
+  }
+  std::vector<Observation> observations;
+  if (features != nullptr) observations = CollectObservations(*features);
+
+  // Prediction, Eqs. (1)-(2) with (6).
+  if (use_odometry) X_OR_previous_ = record.X_OR;
+  state_.Predict(input, params_.control_point_offset_m);
+
+  StepReport report;
+  if (features == nullptr) {
+    report.num_features = state_.num_features();
+    return report;
+  }
+  report.num_observed = static_cast<int>(observations.size());
+
+  // Data association against the predicted map.
+  const Association association = AssociateNearestNeighbour(
+      MahalanobisDistances(observations), gate_, new_feature_threshold_);
+  std::vector<MatchedObservation> matched;
+  std::vector<int> matched_observation;
+  for (int i = 0; i < report.num_observed; ++i) {
+    if (association.outcome[i] == AssociationOutcome::kMatched) {
+      matched.push_back({association.feature[i], observations[i].z, observations[i].R});
+      matched_observation.push_back(i);
+    } else if (association.outcome[i] == AssociationOutcome::kNew) {
+      ++report.num_new;
+    } else {
+      ++report.num_ambiguous;
+    }
+  }
+  report.num_matched = static_cast<int>(matched.size());
+
+  // Correction: Algorithm 1 or 2.
+  if (mode_ == CorrectionMode::kClassical) {
+    report.num_updated = CorrectClassical(&state_, matched);
+  } else {
+    report.num_updated =
+        static_cast<int>(CorrectSelective(&state_, matched, params_.max_updates).size());
+  }
+
+  // Secondary map: every matched line's segment grows with what was seen,
+  // placed with the corrected pose.
+  for (std::size_t m = 0; m < matched.size(); ++m) {
+    const Observation& observation = observations[matched_observation[m]];
+    if (observation.type == FeatureType::kLine) GrowSegment(matched[m].feature, observation);
+  }
+
+  // New features from the corrected pose (inverse observation models).
+  for (int i = 0; i < report.num_observed; ++i) {
+    if (association.outcome[i] != AssociationOutcome::kNew) continue;
+    const Observation& observation = observations[i];
+    const int k = state_.AddFeature(observation.type, observation.z, observation.R);
+    info_.push_back({next_id_++, LineSegment{}});
+    if (observation.type == FeatureType::kLine) {
+      const Pose2 X_WS = X_WR() * state_.X_RS();
+      info_[k].segment = SegmentFromPoints(state_.feature(k), X_WS * observation.p_SA,
+                                           X_WS * observation.p_SB);
+    }
+  }
+  report.num_features = state_.num_features();
+  return report;
+}
+
+std::vector<MapFeature> EkfSlam::Map() const {
+  std::vector<MapFeature> map;
+  map.reserve(state_.num_features());
+  for (int k = 0; k < state_.num_features(); ++k) {
+    MapFeature feature;
+    feature.id = info_[k].id;
+    feature.type = state_.feature_type(k);
+    const Eigen::Vector2d params = state_.feature(k);
+    const Eigen::Matrix2d covariance = state_.feature_covariance(k);
+    if (feature.type == FeatureType::kLine) {
+      // Canonical form; the segment's points do not depend on it.
+      Eigen::Matrix2d J;
+      feature.params = CanonicalLine(params, &J);
+      feature.covariance = J * covariance * J.transpose();
+      feature.has_segment = true;
+      feature.p_WA = PointOnLine(params, info_[k].segment.s_min);
+      feature.p_WB = PointOnLine(params, info_[k].segment.s_max);
+    } else {
+      feature.params = params;
+      feature.covariance = covariance;
+    }
+    map.push_back(feature);
+  }
+  return map;
+}
+
+}  // namespace mjslam::slam

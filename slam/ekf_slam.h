@@ -1,0 +1,148 @@
+#pragma once
+
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "common/pose2.h"
+#include "common/records.h"
+#include "slam/corrections.h"
+#include "slam/observations.h"
+#include "slam/secondary_map.h"
+#include "slam/slam_params.h"
+#include "slam/slam_state.h"
+
+namespace mjslam::slam {
+
+/// Which correction stage the filter runs.
+enum class CorrectionMode {
+  /// Algorithm 1: every matched observation, sequentially.
+  kClassical,
+  /// Algorithm 2: the `max_updates` most informative matched observations.
+  kSelective,
+};
+
+/// What one Step did (expected outcomes are data, not errors).
+struct StepReport {
+  /// Map features after the step.
+  int num_features = 0;
+  /// Observations given (lines + corners); 0 for a prediction-only step.
+  int num_observed = 0;
+  /// Observations associated with a map feature.
+  int num_matched = 0;
+  /// Corrections applied: num_matched (classical) or at most max_updates.
+  int num_updated = 0;
+  /// Observations that became new features.
+  int num_new = 0;
+  /// Observations neither matched nor added (lost a contest for a feature,
+  /// or between the gate and the new-feature threshold).
+  int num_ambiguous = 0;
+};
+
+/// A map feature as the filter estimates it, for maps and metrics.
+struct MapFeature {
+  using Type = FeatureType;
+  /// Stable id, in order of creation from 0.
+  int id = 0;
+  Type type = Type::kLine;
+  /// (r, al) in W in canonical form (r >= 0, al in (-pi, pi]) for a line;
+  /// (x, y) of the corner in W. Metres, radians.
+  Eigen::Vector2d params = Eigen::Vector2d::Zero();
+  /// Marginal covariance of `params` (the 2x2 block of P).
+  Eigen::Matrix2d covariance = Eigen::Matrix2d::Zero();
+  /// True for lines: the secondary map's seen segment from p_WA to p_WB, on
+  /// the current line estimate. False (and zero points) for corners.
+  bool has_segment = false;
+  Eigen::Vector2d p_WA = Eigen::Vector2d::Zero();
+  Eigen::Vector2d p_WB = Eigen::Vector2d::Zero();
+};
+
+/// Bad data given to the filter (a non-finite record, a negative dt, an
+/// observation with a non-finite value or a covariance that is not positive
+/// definite). The message names the field and value.
+class SlamInputError : public std::runtime_error {
+ public:
+  explicit SlamInputError(const std::string& message) : std::runtime_error(message) {}
+};
+
+/// Sequential EKF-SLAM over lines and corners, as in Auat Cheein et al.,
+/// Robotica 29(2), 2011 (slam/README.md, "The filter"): prediction by Eq. (6)
+/// from commands or wheel odometry; Mahalanobis nearest-neighbour association
+/// gated by a chi-square quantile with a duplicate guard; correction by
+/// Algorithm 1 (classical) or Algorithm 2 (feature updating selection); new
+/// features by the inverse observation models; the secondary map of seen
+/// segments. No clocks, printing or files: the caller times it.
+class EkfSlam {
+ public:
+  /// X_WR0: known initial pose of R (the point of control h) in W; its
+  /// covariance is from `params` (zero by default, as in the paper). X_RS:
+  /// the laser mount on R. With `input: odometry`, the odometry frame O is
+  /// R's start pose (X_OR = identity before the first record).
+  /// Throws ParamError if `params` is invalid and SlamInputError if a pose is
+  /// not finite.
+  EkfSlam(const EkfParams& params, CorrectionMode mode, const Pose2& X_WR0, const Pose2& X_RS);
+
+  /// Predicts from the record's input over record.dt_s (the command, or the
+  /// odometry increment since the previous record), then, if `features` is
+  /// not null, associates its lines and corners (given in S) with the map,
+  /// corrects, adds new features and extends the seen segments.
+  /// `features == nullptr`: prediction only. Throws SlamInputError on bad
+  /// data (checked before anything changes: the filter is left as it was).
+  StepReport Step(const SensorRecord& record, const ScanFeatures* features);
+
+  /// Estimated pose of R in W.
+  Pose2 X_WR() const;
+  /// Covariance of (x, y, th) of R.
+  Eigen::Matrix3d pose_covariance() const { return state_.pose_covariance(); }
+  /// The map: every feature with its marginal covariance and, for lines, the
+  /// seen segment. O(L).
+  std::vector<MapFeature> Map() const;
+  /// L, the number of map features.
+  int num_features() const { return state_.num_features(); }
+  /// The state xi = [x, y, th, f_1, ...] (for tests; lines as the filter
+  /// holds them, see SlamState).
+  const Eigen::VectorXd& state() const { return state_.mean(); }
+  /// A copy of P, n x n (for tests; O(n^2)).
+  Eigen::MatrixXd covariance() const { return state_.covariance(); }
+  /// The underlying state (for tests and benchmarks).
+  const SlamState& slam_state() const { return state_; }
+  /// The mode this filter was built with.
+  CorrectionMode mode() const { return mode_; }
+
+ private:
+  // One observation of a scan, as the filter uses it.
+  struct Observation {
+    FeatureType type;
+    Eigen::Vector2d z;
+    Eigen::Matrix2d R;
+    // Seen endpoints in S (lines only).
+    Eigen::Vector2d p_SA;
+    Eigen::Vector2d p_SB;
+  };
+  // Per map feature, besides the state: id and the secondary map.
+  struct FeatureInfo {
+    int id;
+    LineSegment segment;
+  };
+
+  // Observations of `features` with their checked, inflated covariances.
+  std::vector<Observation> CollectObservations(const ScanFeatures& features) const;
+  // The squared Mahalanobis distances, observations x features.
+  Eigen::MatrixXd MahalanobisDistances(const std::vector<Observation>& observations) const;
+  // Extends line k's seen segment with an observation's endpoints, seen from
+  // the current pose estimate.
+  void GrowSegment(int k, const Observation& observation);
+
+  EkfParams params_;
+  CorrectionMode mode_;
+  SlamState state_;
+  double gate_;
+  double new_feature_threshold_;
+  Pose2 X_OR_previous_;
+  std::vector<FeatureInfo> info_;
+  int next_id_ = 0;
+};
+
+}  // namespace mjslam::slam

@@ -1,0 +1,45 @@
+#pragma once
+
+#include <Eigen/Core>
+
+#include "common/pose2.h"
+#include "common/records.h"
+#include "slam/slam_params.h"
+
+namespace mjslam::slam {
+
+/// The input of the paper's Eq. (6) integrated over one record: the products
+/// `u dt` (distance, metres) and `w dt` (heading change, radians). The filter
+/// works with these increments so that dt = 0 and odometry need no division.
+struct MotionInput {
+  /// (u dt, w dt): metres, radians.
+  Eigen::Vector2d increment = Eigen::Vector2d::Zero();
+  /// Covariance of `increment` (the paper's Q, scaled by dt^2 for commands).
+  Eigen::Matrix2d covariance = Eigen::Matrix2d::Zero();
+};
+
+/// The paper's Eq. (6) for the point of control h (frame R, `a_m` ahead of
+/// the wheel axle), pose (x, y, th) of R in W and increment (d, dth) = (u dt,
+/// w dt):
+///   x' = x + d cos th - a dth sin th,  y' = y + d sin th + a dth cos th,
+///   th' = wrap(th + dth).
+/// If not null, `A` receives d pose' / d pose and `W` d pose' / d increment.
+Eigen::Vector3d PredictPose(const Eigen::Vector3d& pose_WR, const Eigen::Vector2d& increment,
+                            double a_m, Eigen::Matrix3d* A = nullptr,
+                            Eigen::Matrix<double, 3, 2>* W = nullptr);
+
+/// The command held over `dt_s` (>= 0) as an input: increment (v dt, w dt),
+/// covariance diag((dt sigma_v)^2, (dt sigma_w)^2) with sigma_v, sigma_w from
+/// `noise` (CommandNoiseParams documents them).
+MotionInput CommandInput(const Twist2& command, double dt_s, const CommandNoiseParams& noise);
+
+/// The wheel-odometry increment between two records as the equivalent input:
+/// with (dx, dy, dth) = X_OR_previous^-1 * X_OR (the motion of R in the
+/// previous R frame), the increment is (dx, dth): the forward distance and
+/// the heading change, the input that Eq. (6) turns into the same forward
+/// motion and heading (the lateral motion a dth is Eq. (6)'s own).
+/// Covariance from `noise` (OdometryNoiseParams documents it).
+MotionInput OdometryInput(const Pose2& X_OR_previous, const Pose2& X_OR,
+                          const OdometryNoiseParams& noise);
+
+}  // namespace mjslam::slam

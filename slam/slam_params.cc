@@ -1,0 +1,59 @@
+#include "slam/slam_params.h"
+
+#include <cmath>
+
+namespace mjslam::slam {
+
+std::vector<ParamProblem> CommandNoiseParams::Validate() const {
+  ParamChecker check;
+  check.NonNegative("v_noise_std_mps", v_noise_std_mps);
+  check.NonNegative("v_noise_fraction", v_noise_fraction);
+  check.NonNegative("w_noise_std_radps", w_noise_std_radps);
+  check.NonNegative("w_noise_fraction", w_noise_fraction);
+  // A zero constant part would make a stopped robot's prediction exact.
+  check.Require(v_noise_std_mps > 0.0 || w_noise_std_radps > 0.0, "v_noise_std_mps",
+                v_noise_std_mps, "a value > 0 when w_noise_std_radps is 0");
+  return check.problems();
+}
+
+std::vector<ParamProblem> OdometryNoiseParams::Validate() const {
+  ParamChecker check;
+  check.NonNegative("distance_noise_std_m", distance_noise_std_m);
+  check.NonNegative("distance_noise_fraction", distance_noise_fraction);
+  check.NonNegative("heading_noise_std_rad", heading_noise_std_rad);
+  check.NonNegative("heading_noise_fraction", heading_noise_fraction);
+  check.NonNegative("heading_noise_per_distance_radpm", heading_noise_per_distance_radpm);
+  return check.problems();
+}
+
+std::vector<ParamProblem> EkfParams::Validate() const {
+  ParamChecker check;
+  check.OneOf("input", input, {"command", "odometry"});
+  check.Positive("control_point_offset_m", control_point_offset_m);
+  check.Require(std::isfinite(control_point_offset_m), "control_point_offset_m",
+                control_point_offset_m, "a finite value");
+  check.Merge("command_noise", command_noise.Validate());
+  check.Merge("odometry_noise", odometry_noise.Validate());
+  check.NonNegative("initial_position_std_m", initial_position_std_m);
+  check.NonNegative("initial_heading_std_rad", initial_heading_std_rad);
+  check.NonNegative("extra_line_rho_std_m", extra_line_rho_std_m);
+  check.NonNegative("extra_line_alpha_std_rad", extra_line_alpha_std_rad);
+  check.NonNegative("extra_corner_range_std_m", extra_corner_range_std_m);
+  check.NonNegative("extra_corner_bearing_std_rad", extra_corner_bearing_std_rad);
+  check.Require(gate_probability > 0.0 && gate_probability < 1.0, "gate_probability",
+                gate_probability, "a probability in (0, 1)");
+  check.Require(new_feature_probability >= gate_probability && new_feature_probability < 1.0,
+                "new_feature_probability", new_feature_probability,
+                "a probability in [gate_probability, 1)");
+  check.Require(max_updates >= 1, "max_updates", max_updates, "a value >= 1");
+  return check.problems();
+}
+
+std::vector<ParamProblem> SlamParams::Validate() const {
+  ParamChecker check;
+  check.Merge("features", features.Validate());
+  check.Merge("ekf", ekf.Validate());
+  return check.problems();
+}
+
+}  // namespace mjslam::slam

@@ -1,0 +1,159 @@
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "common/params.h"
+#include "slam/feature_extraction.h"
+
+namespace mjslam::slam {
+
+/// Noise of the commanded velocities as the filter's input (`input:
+/// command`). The robot's real motion differs from the command through the
+/// wheel dynamics (lag, acceleration limits, slip), so these must cover that
+/// difference, not only actuator noise. One standard deviation each, held
+/// over the record's `dt_s`: sigma_v = v_noise_std_mps + v_noise_fraction |v|,
+/// sigma_w = w_noise_std_radps + w_noise_fraction |w|. Serialized under
+/// `slam.ekf.command_noise.*`.
+struct CommandNoiseParams {
+  /// Constant part of the linear-velocity noise, m/s.
+  double v_noise_std_mps = 0.03;
+  /// Part of the linear-velocity noise proportional to |v| (dimensionless).
+  double v_noise_fraction = 0.1;
+  /// Constant part of the angular-velocity noise, rad/s.
+  double w_noise_std_radps = 0.03;
+  /// Part of the angular-velocity noise proportional to |w| (dimensionless).
+  double w_noise_fraction = 0.1;
+
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit(MJSLAM_NVP(v_noise_std_mps));
+    a->Visit(MJSLAM_NVP(v_noise_fraction));
+    a->Visit(MJSLAM_NVP(w_noise_std_radps));
+    a->Visit(MJSLAM_NVP(w_noise_fraction));
+  }
+  /// Every out-of-range field, keys relative to this struct.
+  std::vector<ParamProblem> Validate() const;
+  /// Throws ParamError listing every problem of Validate().
+  void ValidateOrThrow() const { ThrowIfProblems(Validate()); }
+};
+
+/// Noise of the wheel-odometry increment as the filter's input (`input:
+/// odometry`), per record, one standard deviation each, with d the distance
+/// increment (m) and dth the heading increment (rad) between two records:
+/// sigma_d = distance_noise_std_m + distance_noise_fraction |d|,
+/// sigma_dth = heading_noise_std_rad + heading_noise_fraction |dth|
+///             + heading_noise_per_distance_radpm |d|.
+/// Serialized under `slam.ekf.odometry_noise.*`.
+struct OdometryNoiseParams {
+  /// Constant part of the distance-increment noise per record, metres.
+  double distance_noise_std_m = 0.001;
+  /// Part of the distance-increment noise proportional to |d|.
+  double distance_noise_fraction = 0.05;
+  /// Constant part of the heading-increment noise per record, radians.
+  double heading_noise_std_rad = 0.001;
+  /// Part of the heading-increment noise proportional to |dth|.
+  double heading_noise_fraction = 0.05;
+  /// Part of the heading-increment noise proportional to the distance
+  /// travelled (wheel-radius mismatch, slip), rad per metre.
+  double heading_noise_per_distance_radpm = 0.02;
+
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit(MJSLAM_NVP(distance_noise_std_m));
+    a->Visit(MJSLAM_NVP(distance_noise_fraction));
+    a->Visit(MJSLAM_NVP(heading_noise_std_rad));
+    a->Visit(MJSLAM_NVP(heading_noise_fraction));
+    a->Visit(MJSLAM_NVP(heading_noise_per_distance_radpm));
+  }
+  /// Every out-of-range field, keys relative to this struct.
+  std::vector<ParamProblem> Validate() const;
+  /// Throws ParamError listing every problem of Validate().
+  void ValidateOrThrow() const { ThrowIfProblems(Validate()); }
+};
+
+/// Parameters of the EKF-SLAM filters (slam/README.md, "The filter").
+/// Serialized under `slam.ekf.*`.
+struct EkfParams {
+  /// What drives the prediction (Eq. 6): "command" (the record's command held
+  /// over dt, as in the paper) or "odometry" (the wheel-odometry increment
+  /// between consecutive records, turned into the equivalent input).
+  std::string input = "command";
+  /// Offset `a` of the point of control h (frame R) ahead of the wheel axle,
+  /// metres (> 0). Must match the robot's (`robot.control_point_offset_m`).
+  double control_point_offset_m = 0.15;
+  /// Input noise when `input` is "command".
+  CommandNoiseParams command_noise;
+  /// Input noise when `input` is "odometry".
+  OdometryNoiseParams odometry_noise;
+
+  /// Standard deviation of the initial position of R, metres (0: known start,
+  /// as in the paper).
+  double initial_position_std_m = 0.0;
+  /// Standard deviation of the initial heading of R, radians (0: known).
+  double initial_heading_std_rad = 0.0;
+
+  /// Model-error noise added (in quadrature, one standard deviation) to the
+  /// covariance the extractor gives each observation: line rho, metres.
+  double extra_line_rho_std_m = 0.0;
+  /// Same for line alpha, radians.
+  double extra_line_alpha_std_rad = 0.0;
+  /// Same for corner range, metres.
+  double extra_corner_range_std_m = 0.0;
+  /// Same for corner bearing, radians.
+  double extra_corner_bearing_std_rad = 0.0;
+
+  /// Data association gate: an observation matches a map feature of its type
+  /// when the Mahalanobis distance d^2 = nu^T S^-1 nu is below the chi-square
+  /// quantile (2 dof) of this probability, in (0, 1). 0.99 gives 9.21.
+  double gate_probability = 0.99;
+  /// Duplicate guard: an unmatched observation becomes a new feature only if
+  /// d^2 to every map feature of its type is at least the chi-square quantile
+  /// (2 dof) of this probability (>= gate_probability, < 1). Observations in
+  /// between are neither matched nor added. 0.9999 gives 18.4.
+  double new_feature_probability = 0.9999;
+  /// MAX of the paper's Algorithm 2: the most features used per correction by
+  /// the selective filter (>= 1). Ignored by the classical filter.
+  int max_updates = 2;
+
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit(MJSLAM_NVP(input));
+    a->Visit(MJSLAM_NVP(control_point_offset_m));
+    a->Visit(MJSLAM_NVP(command_noise));
+    a->Visit(MJSLAM_NVP(odometry_noise));
+    a->Visit(MJSLAM_NVP(initial_position_std_m));
+    a->Visit(MJSLAM_NVP(initial_heading_std_rad));
+    a->Visit(MJSLAM_NVP(extra_line_rho_std_m));
+    a->Visit(MJSLAM_NVP(extra_line_alpha_std_rad));
+    a->Visit(MJSLAM_NVP(extra_corner_range_std_m));
+    a->Visit(MJSLAM_NVP(extra_corner_bearing_std_rad));
+    a->Visit(MJSLAM_NVP(gate_probability));
+    a->Visit(MJSLAM_NVP(new_feature_probability));
+    a->Visit(MJSLAM_NVP(max_updates));
+  }
+  /// Every out-of-range field, keys relative to this struct (nested ones as
+  /// `command_noise.v_noise_std_mps`, ...).
+  std::vector<ParamProblem> Validate() const;
+  /// Throws ParamError listing every problem of Validate().
+  void ValidateOrThrow() const { ThrowIfProblems(Validate()); }
+};
+
+/// Everything the SLAM needs: feature extraction and filter parameters.
+/// Serialized under `slam.*` (`slam.features.*`, `slam.ekf.*`).
+struct SlamParams {
+  FeatureExtractionParams features;
+  EkfParams ekf;
+
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit(MJSLAM_NVP(features));
+    a->Visit(MJSLAM_NVP(ekf));
+  }
+  /// Problems of both parts, keys prefixed `features.` and `ekf.`.
+  std::vector<ParamProblem> Validate() const;
+  /// Throws ParamError listing every problem of Validate().
+  void ValidateOrThrow() const { ThrowIfProblems(Validate()); }
+};
+
+}  // namespace mjslam::slam

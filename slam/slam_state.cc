@@ -1,0 +1,228 @@
+#include "slam/slam_state.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "common/angles.h"
+#include "common/check.h"
+
+namespace mjslam::slam {
+namespace {
+
+// Room for this many features before the first growth of the buffer.
+constexpr int kInitialFeatureCapacity = 16;
+// Columns of P are padded to a multiple of this many doubles (64 bytes), so
+// that every column starts on a cache line and vector loads are aligned.
+constexpr int kColumnPadding = 8;
+
+int PaddedSize(int n) { return (n + kColumnPadding - 1) / kColumnPadding * kColumnPadding; }
+
+// Largest distance at which a corner counts as sitting on the sensor, metres.
+constexpr double kMinCornerRange = 1e-9;
+
+}  // namespace
+
+SlamState::SlamState(const Eigen::Vector3d& pose_WR, const Eigen::Matrix3d& pose_covariance,
+                     const Pose2& X_RS)
+    : X_RS_(X_RS), x_(pose_WR) {
+  x_.z() = WrapAngle(x_.z());
+  const int capacity = PaddedSize(3 + 2 * kInitialFeatureCapacity);
+  P_ = Eigen::MatrixXd::Zero(capacity, capacity);
+  P_.topLeftCorner<3, 3>() = 0.5 * (pose_covariance + pose_covariance.transpose());
+  scratch_ = Eigen::MatrixXd::Zero(capacity, 2);
+}
+
+Eigen::Matrix<double, 5, 5> SlamState::JointCovariance(int k) const {
+  const int j = FeatureIndex(k);
+  Eigen::Matrix<double, 5, 5> block;
+  block.topLeftCorner<3, 3>() = P_.topLeftCorner<3, 3>();
+  block.topRightCorner<3, 2>() = P_.block<3, 2>(0, j);
+  block.bottomLeftCorner<2, 3>() = P_.block<2, 3>(j, 0);
+  block.bottomRightCorner<2, 2>() = P_.block<2, 2>(j, j);
+  return block;
+}
+
+void SlamState::Predict(const MotionInput& input, double a_m) {
+  Eigen::Matrix3d A;
+  Eigen::Matrix<double, 3, 2> W;
+  x_.head<3>() = PredictPose(x_.head<3>(), input.increment, a_m, &A, &W);
+
+  // Pose block: A P_pp A^T + W Q W^T, symmetrised exactly.
+  const Eigen::Matrix3d P_pp = P_.topLeftCorner<3, 3>();
+  Eigen::Matrix3d P_pp_new;
+  P_pp_new.noalias() = A * P_pp * A.transpose();
+  P_pp_new.noalias() += W * input.covariance * W.transpose();
+  P_.topLeftCorner<3, 3>() = 0.5 * (P_pp_new + P_pp_new.transpose());
+
+  // Cross terms P_fp <- P_fp A^T. A is the identity but for (0,2) and (1,2),
+  // so only the x and y columns change: contiguous, O(n).
+  const int m = n_ - 3;
+  if (m == 0) return;
+  P_.col(0).segment(3, m) += A(0, 2) * P_.col(2).segment(3, m);
+  P_.col(1).segment(3, m) += A(1, 2) * P_.col(2).segment(3, m);
+  // Mirror into the pose rows, the same values (P stays exactly symmetric).
+  P_.block(0, 3, 3, m) = P_.block(3, 0, m, 3).transpose();
+}
+
+SlamState::Measurement SlamState::Measure(int k) const {
+  MJSLAM_CHECK(k >= 0 && k < num_features());
+  Measurement m;
+  const Eigen::Vector3d pose_WR = pose();
+  const Eigen::Vector2d f = feature(k);
+  if (types_[k] == FeatureType::kCorner) {
+    const Eigen::Vector3d pose_WS = SensorPose(pose_WR, X_RS_);
+    if ((f - pose_WS.head<2>()).norm() <= kMinCornerRange) return m;
+  }
+  m.h = PredictObservation(types_[k], pose_WR, f, X_RS_, &m.H_pose, &m.H_feature);
+
+  // H P H^T over the 5x5 block of the pose and the feature.
+  Eigen::Matrix<double, 2, 5> H;
+  H << m.H_pose, m.H_feature;
+  const Eigen::Matrix<double, 5, 5> P_block = JointCovariance(k);
+  Eigen::Matrix2d HPHt;
+  HPHt.noalias() = H * P_block * H.transpose();
+  m.HPHt = 0.5 * (HPHt + HPHt.transpose());
+  m.valid = true;
+  return m;
+}
+
+Eigen::Matrix2d SlamState::InnovationCovariance(int k, const Eigen::Matrix2d& R) const {
+  const Measurement m = Measure(k);
+  MJSLAM_CHECK(m.valid);
+  return m.HPHt + R;
+}
+
+void SlamState::Reserve(int n) {
+  if (n <= P_.cols()) return;
+  const int capacity = PaddedSize(std::max(n, 2 * static_cast<int>(P_.cols())));
+  Eigen::MatrixXd grown = Eigen::MatrixXd::Zero(capacity, capacity);
+  grown.topLeftCorner(n_, n_) = P_.topLeftCorner(n_, n_);
+  P_.swap(grown);
+  scratch_ = Eigen::MatrixXd::Zero(capacity, 2);
+}
+
+int SlamState::AddFeature(FeatureType type, const Eigen::Vector2d& z, const Eigen::Matrix2d& R) {
+  // Inverse observation model and its Jacobians at the current pose.
+  Eigen::Matrix<double, 2, 3> G_pose;
+  Eigen::Matrix2d G_z;
+  const Eigen::Vector2d f = InitializeFeature(type, pose(), z, X_RS_, &G_pose, &G_z);
+
+  const int j = n_;
+  Reserve(n_ + 2);
+
+  // Cross-covariance with everything so far: P_fx = G_pose P_px. By symmetry
+  // P_px^T is the first three columns, so the new columns are contiguous.
+  P_.block(0, j, n_, 2).noalias() = P_.block(0, 0, n_, 3) * G_pose.transpose();
+  P_.block(j, 0, 2, n_) = P_.block(0, j, n_, 2).transpose();
+
+  // The feature's own block.
+  const Eigen::Matrix3d P_pp = P_.topLeftCorner<3, 3>();
+  Eigen::Matrix2d P_ff;
+  P_ff.noalias() = G_pose * P_pp * G_pose.transpose();
+  P_ff.noalias() += G_z * R * G_z.transpose();
+  P_.block<2, 2>(j, j) = 0.5 * (P_ff + P_ff.transpose());
+
+  x_.conservativeResize(n_ + 2);
+  x_.segment<2>(j) = f;
+  types_.push_back(type);
+  n_ += 2;
+  return num_features() - 1;
+}
+
+void SlamState::Update(int k, const Eigen::Vector2d& z, const Eigen::Matrix2d& R) {
+  MJSLAM_CHECK(k >= 0 && k < num_features());
+  const Eigen::Vector3d pose_WR = pose();
+  Eigen::Matrix<double, 2, 3> H_pose;
+  Eigen::Matrix2d H_feature;
+  const Eigen::Vector2d h = PredictObservation(types_[k], pose_WR, feature(k), X_RS_, &H_pose,
+                                               &H_feature);
+  const Eigen::Vector2d nu = Innovation(z, h);
+
+  const int n = n_;
+  const int j = FeatureIndex(k);
+  const Eigen::Index stride = P_.outerStride();
+  const double* p0 = P_.data();
+  const double* p1 = p0 + stride;
+  const double* p2 = p1 + stride;
+  const double* pj = p0 + j * stride;
+  const double* pj1 = pj + stride;
+  double* u0 = scratch_.data();
+  double* u1 = u0 + scratch_.outerStride();
+
+  // U = P H^T from the 5 columns of P that H touches.
+  for (int r = 0; r < n; ++r) {
+    u0[r] = H_pose(0, 0) * p0[r] + H_pose(0, 1) * p1[r] + H_pose(0, 2) * p2[r] +
+            H_feature(0, 0) * pj[r] + H_feature(0, 1) * pj1[r];
+    u1[r] = H_pose(1, 0) * p0[r] + H_pose(1, 1) * p1[r] + H_pose(1, 2) * p2[r] +
+            H_feature(1, 0) * pj[r] + H_feature(1, 1) * pj1[r];
+  }
+
+  // S = H U + R, from U's pose and feature rows.
+  Eigen::Matrix<double, 5, 2> U_block;
+  U_block << u0[0], u1[0], u0[1], u1[1], u0[2], u1[2], u0[j], u1[j], u0[j + 1], u1[j + 1];
+  Eigen::Matrix<double, 2, 5> H;
+  H << H_pose, H_feature;
+  Eigen::Matrix2d S;
+  S.noalias() = H * U_block;
+  S += R;
+  S = 0.5 * (S + S.transpose());
+
+  // S = L L^T (2x2 Cholesky).
+  MJSLAM_CHECK(S(0, 0) > 0.0);
+  const double l11 = std::sqrt(S(0, 0));
+  const double l21 = S(1, 0) / l11;
+  const double schur = S(1, 1) - l21 * l21;
+  MJSLAM_CHECK(schur > 0.0);
+  const double l22 = std::sqrt(schur);
+
+  // V = U L^-T in place, so that K S K^T = V V^T and K nu = V L^-1 nu.
+  const double inv_l11 = 1.0 / l11;
+  const double inv_l22 = 1.0 / l22;
+  for (int r = 0; r < n; ++r) {
+    const double v0 = u0[r] * inv_l11;
+    u0[r] = v0;
+    u1[r] = (u1[r] - l21 * v0) * inv_l22;
+  }
+  const double w0 = nu.x() * inv_l11;
+  const double w1 = (nu.y() - l21 * w0) * inv_l22;
+
+  // Mean: xi <- xi + K nu.
+  double* x = x_.data();
+  for (int r = 0; r < n; ++r) x[r] += u0[r] * w0 + u1[r] * w1;
+
+  // Covariance: P <- P - V V^T, two columns per sweep so that V is read once
+  // per pair. Element (r, c) is P(r, c) - fma(v0[r], v0[c], v1[r] v1[c]) and
+  // element (c, r) multiplies the same numbers, so P stays exactly symmetric.
+  double* P = P_.data();
+  int c = 0;
+  for (; c + 1 < n; c += 2) {
+    double* col_a = P + c * stride;
+    double* col_b = col_a + stride;
+    const double a0 = u0[c];
+    const double a1 = u1[c];
+    const double b0 = u0[c + 1];
+    const double b1 = u1[c + 1];
+    for (int r = 0; r < n; ++r) {
+      const double v0 = u0[r];
+      const double v1 = u1[r];
+      col_a[r] -= std::fma(v0, a0, v1 * a1);
+      col_b[r] -= std::fma(v0, b0, v1 * b1);
+    }
+  }
+  for (; c < n; ++c) {
+    double* col = P + c * stride;
+    const double a0 = u0[c];
+    const double a1 = u1[c];
+    for (int r = 0; r < n; ++r) col[r] -= std::fma(u0[r], a0, u1[r] * a1);
+  }
+
+  // Angles back into (-pi, pi].
+  x_.z() = WrapAngle(x_.z());
+  for (int f = 0; f < num_features(); ++f) {
+    if (types_[f] != FeatureType::kLine) continue;
+    double& al = x[FeatureIndex(f) + 1];
+    if (al > kPi || al <= -kPi) al = WrapAngle(al);
+  }
+}
+
+}  // namespace mjslam::slam

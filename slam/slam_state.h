@@ -1,0 +1,122 @@
+#pragma once
+
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "common/pose2.h"
+#include "slam/motion_model.h"
+#include "slam/observation_models.h"
+
+namespace mjslam::slam {
+
+/// The EKF-SLAM state xi = [x, y, th, f_1, ..., f_L] of frame R and the map,
+/// its covariance P, and the sparse operations of the paper's filter on them
+/// (slam/README.md, "The filter"): prediction (Eqs. 1-2) touching only the
+/// pose rows and columns, augmentation with a new feature, and one sequential
+/// correction (Algorithm 1's body) that uses 5 columns of P and a symmetric
+/// rank-2 downdate. Feature k occupies state indices 3 + 2k and 4 + 2k.
+///
+/// P is stored in a buffer with spare capacity (doubled when full, columns
+/// padded to 64-byte multiples), so adding a feature costs O(n), not a copy.
+/// P is kept exactly symmetric: every update writes both triangles with the
+/// same floating-point values.
+///
+/// Line features keep the (r, al) the filter moved them to: r may become
+/// negative only for a line passing through W's origin within its
+/// uncertainty; PredictLine canonicalises the prediction, so this is
+/// harmless, and EkfSlam::Map() reports the canonical form.
+class SlamState {
+ public:
+  /// Predicted measurement of one feature from the current state, with the
+  /// model's Jacobians and H P H^T (without R).
+  struct Measurement {
+    /// False when the model is undefined (a corner at the sensor position).
+    bool valid = false;
+    Eigen::Vector2d h = Eigen::Vector2d::Zero();
+    Eigen::Matrix<double, 2, 3> H_pose = Eigen::Matrix<double, 2, 3>::Zero();
+    Eigen::Matrix2d H_feature = Eigen::Matrix2d::Zero();
+    /// H P H^T over the 5x5 block of the pose and the feature.
+    Eigen::Matrix2d HPHt = Eigen::Matrix2d::Zero();
+  };
+
+  /// A state with no features: pose (x, y, th) of R in W (metres, radians),
+  /// its 3x3 covariance (symmetric PSD, may be zero), and the laser mount
+  /// X_RS used by the observation models.
+  SlamState(const Eigen::Vector3d& pose_WR, const Eigen::Matrix3d& pose_covariance,
+            const Pose2& X_RS);
+
+  /// n = 3 + 2 L.
+  int dimension() const { return n_; }
+  /// L.
+  int num_features() const { return static_cast<int>(types_.size()); }
+  /// Type of feature k.
+  FeatureType feature_type(int k) const { return types_[k]; }
+  /// State index of feature k's first component.
+  static int FeatureIndex(int k) { return 3 + 2 * k; }
+
+  /// The mean xi (size n).
+  const Eigen::VectorXd& mean() const { return x_; }
+  /// (x, y, th) of R in W.
+  Eigen::Vector3d pose() const { return x_.head<3>(); }
+  /// Parameters of feature k: (r, al) or p_WC.
+  Eigen::Vector2d feature(int k) const { return x_.segment<2>(FeatureIndex(k)); }
+  /// The n x n covariance P, a view into the buffer.
+  Eigen::Block<const Eigen::MatrixXd> covariance() const {
+    return P_.topLeftCorner(n_, n_);
+  }
+  /// P's 3x3 pose block.
+  Eigen::Matrix3d pose_covariance() const { return P_.topLeftCorner<3, 3>(); }
+  /// P's 2x2 block of feature k.
+  Eigen::Matrix2d feature_covariance(int k) const {
+    return P_.block<2, 2>(FeatureIndex(k), FeatureIndex(k));
+  }
+  /// P's 5x5 block of the pose and feature k (pose first).
+  Eigen::Matrix<double, 5, 5> JointCovariance(int k) const;
+  /// The laser mount.
+  const Pose2& X_RS() const { return X_RS_; }
+  /// Columns allocated for P (>= n), for tests of the growth policy.
+  int capacity() const { return static_cast<int>(P_.cols()); }
+
+  /// Prediction, Eqs. (1)-(2) with Eq. (6): pose <- f(pose, increment),
+  /// P <- A P A^T + W Q W^T with Q = input.covariance, for the control point
+  /// `a_m` ahead of the axle. O(n): only the pose rows and columns change.
+  void Predict(const MotionInput& input, double a_m);
+
+  /// Predicted measurement of feature k at the current mean. O(1).
+  Measurement Measure(int k) const;
+
+  /// Augments the state with a feature initialised from observation z with
+  /// covariance R (2x2 SPD) by the inverse observation model g:
+  ///   f = g(pose, z),  P_ff = G_pose P_pp G_pose^T + G_z R G_z^T,
+  ///   P_fx = G_pose P_px  (the pose rows of P, all columns).
+  /// O(n) (amortised: the buffer doubles when full). Returns the new index k.
+  int AddFeature(FeatureType type, const Eigen::Vector2d& z, const Eigen::Matrix2d& R);
+
+  /// One sequential EKF correction (Algorithm 1, sentences iv-vi) with
+  /// observation z (canonical for lines) of feature k, covariance R (SPD):
+  ///   nu = z - h(xi) (angle wrapped), S = H P H^T + R, K = P H^T S^-1,
+  ///   xi <- xi + K nu,  P <- P - K S K^T = P - V V^T with V = P H^T L^-T,
+  ///   S = L L^T. P H^T uses 5 columns of P; the downdate is O(n^2) with no
+  ///   dense n x n product. Angles are wrapped afterwards. Precondition
+  ///   (checked): Measure(k).valid and S positive definite.
+  void Update(int k, const Eigen::Vector2d& z, const Eigen::Matrix2d& R);
+
+  /// The innovation covariance S = H P H^T + R of observation (k, R). O(1).
+  Eigen::Matrix2d InnovationCovariance(int k, const Eigen::Matrix2d& R) const;
+
+ private:
+  // Makes room for `n` state entries, doubling the buffer if needed.
+  void Reserve(int n);
+
+  Pose2 X_RS_;
+  int n_ = 3;
+  Eigen::VectorXd x_;
+  // Capacity x capacity buffer; P is its top-left n_ x n_ block.
+  Eigen::MatrixXd P_;
+  std::vector<FeatureType> types_;
+  // Scratch for P H^T and V, capacity x 2.
+  Eigen::MatrixXd scratch_;
+};
+
+}  // namespace mjslam::slam

@@ -1,0 +1,375 @@
+#include "config/config.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cstdint>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "tests/config/toy_params.h"
+
+namespace mjslam::config {
+namespace {
+
+using testing::ToyParams;
+
+// The message of the ConfigError that loading `yaml` (named "x.yaml") throws.
+std::string ErrorOf(const std::string& yaml, const std::vector<std::string>& overrides = {}) {
+  try {
+    LoadConfigString<ToyParams>(yaml, "x.yaml", overrides);
+  } catch (const ConfigError& error) {
+    return error.what();
+  }
+  ADD_FAILURE() << "no ConfigError for:\n" << yaml;
+  return {};
+}
+
+::testing::AssertionResult Contains(const std::string& text, const std::string& part) {
+  if (text.find(part) != std::string::npos) return ::testing::AssertionSuccess();
+  return ::testing::AssertionFailure() << "'" << part << "' not in:\n" << text;
+}
+
+// Local classes cannot have member templates: this one lives here.
+struct SpecialToyParams {
+  int offset = 0;
+  double limit = 0.0;
+  double low = 0.0;
+  bool flag = false;
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit(MJSLAM_NVP(offset));
+    a->Visit(MJSLAM_NVP(limit));
+    a->Visit(MJSLAM_NVP(low));
+    a->Visit(MJSLAM_NVP(flag));
+  }
+};
+
+std::size_t LineCount(const std::string& text) {
+  return static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n')) + 1;
+}
+
+TEST(ConfigTest, AbsentKeysKeepDefaults) {
+  const ToyParams params = LoadConfigString<ToyParams>(
+      "rate_hz: 20\n"
+      "laser:\n"
+      "  beam_count: 90\n",
+      "x.yaml");
+  const ToyParams defaults;
+  EXPECT_EQ(params.rate_hz, 20.0);
+  EXPECT_EQ(params.laser.beam_count, 90);
+  EXPECT_EQ(params.min_range_m, defaults.min_range_m);
+  EXPECT_EQ(params.laser.range_noise_std_m, defaults.laser.range_noise_std_m);
+  EXPECT_EQ(params.laser.mode, defaults.laser.mode);
+  EXPECT_EQ(params.laser.gains, defaults.laser.gains);
+  EXPECT_EQ(params.laser.inner.gain, defaults.laser.inner.gain);
+}
+
+TEST(ConfigTest, EmptyTextGivesDefaults) {
+  const ToyParams defaults;
+  for (const std::string text : {"", "\n", "# only a comment\n", "---\n"}) {
+    const ToyParams params = LoadConfigString<ToyParams>(text, "x.yaml");
+    EXPECT_EQ(ToYaml(params), ToYaml(defaults)) << "text: '" << text << "'";
+  }
+}
+
+TEST(ConfigTest, NullStructKeepsDefaults) {
+  const ToyParams params = LoadConfigString<ToyParams>("laser:\nrate_hz: 3\n", "x.yaml");
+  EXPECT_EQ(params.laser.beam_count, 181);
+  EXPECT_EQ(params.rate_hz, 3.0);
+}
+
+TEST(ConfigTest, ReadsEverySupportedType) {
+  const ToyParams params = LoadConfigString<ToyParams>(
+      "rate_hz: 1e-9\n"
+      "min_range_m: -.5\n"
+      "max_range_m: +12\n"
+      "laser:\n"
+      "  range_noise_std_m: 0.1\n"
+      "  beam_count: -7\n"
+      "  enabled: false\n"
+      "  seed: 18446744073709551615\n"
+      "  mode: \"noisy\"\n"
+      "  gains: [0.5, 3]\n"
+      "  waypoints:\n"
+      "    - [0, 0]\n"
+      "    - [1.5, -2]\n"
+      "  inner:\n"
+      "    gain: 1\n"
+      "    offset_m: [1, 2, 3.25]\n",
+      "x.yaml", {"laser.beam_count=5"});  // -7 would fail Validate
+  EXPECT_EQ(params.rate_hz, 1e-9);
+  EXPECT_EQ(params.min_range_m, -0.5);
+  EXPECT_EQ(params.max_range_m, 12.0);
+  EXPECT_EQ(params.laser.range_noise_std_m, 0.1);
+  EXPECT_EQ(params.laser.beam_count, 5);
+  EXPECT_FALSE(params.laser.enabled);
+  EXPECT_EQ(params.laser.seed, std::numeric_limits<std::uint64_t>::max());
+  EXPECT_EQ(params.laser.mode, "noisy");
+  EXPECT_EQ(params.laser.gains, (std::vector<double>{0.5, 3.0}));
+  ASSERT_EQ(params.laser.waypoints.size(), 2u);
+  EXPECT_EQ(params.laser.waypoints[1][0], 1.5);
+  EXPECT_EQ(params.laser.waypoints[1][1], -2.0);
+  EXPECT_EQ(params.laser.inner.gain, 1.0);
+  EXPECT_EQ(params.laser.inner.offset_m, (std::array<double, 3>{1.0, 2.0, 3.25}));
+}
+
+TEST(ConfigTest, ReadsNegativeIntAndSpecialDoubles) {
+  const SpecialToyParams local = LoadConfigString<SpecialToyParams>(
+      "offset: -2147483648\nlimit: .inf\nlow: -.Inf\nflag: True\n", "x.yaml");
+  EXPECT_EQ(local.offset, std::numeric_limits<int>::min());
+  EXPECT_EQ(local.limit, std::numeric_limits<double>::infinity());
+  EXPECT_EQ(local.low, -std::numeric_limits<double>::infinity());
+  EXPECT_TRUE(local.flag);
+}
+
+TEST(ConfigTest, UnknownKeyListsKnownKeysWithLineCol) {
+  const std::string message = ErrorOf(
+      "rate_hz: 1\n"
+      "laser:\n"
+      "  rnage_noise_std_m: 1\n");
+  EXPECT_TRUE(Contains(message, "x.yaml:3:3: laser.rnage_noise_std_m: unknown key"));
+  EXPECT_TRUE(Contains(message, "did you mean 'range_noise_std_m'?"));
+  EXPECT_TRUE(Contains(message,
+                       "(known keys of laser: range_noise_std_m, beam_count, enabled, seed, "
+                       "mode, gains, waypoints, inner)"));
+  EXPECT_EQ(LineCount(message), 1u) << message;
+}
+
+TEST(ConfigTest, UnknownTopLevelKeyListsTopLevelKeys) {
+  const std::string message = ErrorOf("rate_hz: 1\nsimulator: {}\n");
+  EXPECT_TRUE(Contains(message, "x.yaml:2:1: simulator: unknown key (known keys: rate_hz, "
+                                "min_range_m, max_range_m, laser)"));
+}
+
+TEST(ConfigTest, UnknownKeySuggestsOnlyCloseMatches) {
+  // A swap of neighbours is one edit; five letters allow one edit.
+  EXPECT_TRUE(Contains(ErrorOf("lasre: {}\n"), "lasre: unknown key, did you mean 'laser'? (known"));
+  // Two edits away from "laser" in four letters: no suggestion.
+  EXPECT_TRUE(Contains(ErrorOf("base: 1\n"), "base: unknown key (known keys: rate_hz,"));
+}
+
+TEST(ConfigTest, DuplicateKeyRejected) {
+  const std::string message = ErrorOf(
+      "rate_hz: 1\n"
+      "laser:\n"
+      "  beam_count: 3\n"
+      "  beam_count: 4\n"
+      "rate_hz: 2\n");
+  EXPECT_TRUE(Contains(message, "x.yaml:4:3: laser.beam_count: duplicate key (first given at "
+                                "x.yaml:3:3)"));
+  EXPECT_TRUE(Contains(message, "x.yaml:5:1: rate_hz: duplicate key (first given at x.yaml:1:1)"));
+  EXPECT_EQ(LineCount(message), 2u) << message;
+}
+
+TEST(ConfigTest, WrongTypesRejectedWithMark) {
+  struct Case {
+    std::string yaml;
+    std::string expected;
+  };
+  const std::vector<Case> cases = {
+      {"rate_hz: abc\n", "x.yaml:1:10: rate_hz: expected a number (got abc)"},
+      {"rate_hz: \"1.5\"\n", "x.yaml:1:10: rate_hz: expected an unquoted number (got \"1.5\")"},
+      {"rate_hz: inf\n", "x.yaml:1:10: rate_hz: expected a number (got inf)"},
+      {"rate_hz: 1e999\n", "x.yaml:1:10: rate_hz: expected a number within the range of a double "
+                           "(got 1e999)"},
+      {"rate_hz:\n", "x.yaml:1:1: rate_hz: expected a number (got null)"},
+      {"rate_hz: {a: 1}\n", "x.yaml:1:10: rate_hz: expected a number (got a map)"},
+      {"laser:\n  beam_count: 1.5\n", "x.yaml:2:15: laser.beam_count: expected an integer (got 1.5)"},
+      {"laser:\n  beam_count: 3000000000\n",
+       "laser.beam_count: expected an integer in [-2147483648, 2147483647] (got 3000000000)"},
+      {"laser:\n  seed: -3\n", "x.yaml:2:9: laser.seed: expected a non-negative integer (got -3)"},
+      {"laser:\n  enabled: yes\n", "x.yaml:2:12: laser.enabled: expected true or false (got yes)"},
+      {"laser:\n  mode: [a]\n", "x.yaml:2:9: laser.mode: expected a string (got a sequence of 1 item)"},
+      {"laser:\n  gains: 5\n",
+       "x.yaml:2:10: laser.gains: expected a sequence of numbers (got 5)"},
+      {"laser:\n  gains: [1, x, 2]\n", "x.yaml:2:14: laser.gains[1]: expected a number (got x)"},
+      {"laser:\n  waypoints: [[0, 0], [1]]\n",
+       "x.yaml:2:23: laser.waypoints[1]: expected a sequence of 2 numbers (got a sequence of 1 "
+       "item)"},
+      {"laser:\n  waypoints:\n    - [0, 0]\n    - [1, b]\n",
+       "x.yaml:4:11: laser.waypoints[1][1]: expected a number (got b)"},
+      {"laser:\n  inner:\n    offset_m: [1, 2]\n",
+       "x.yaml:3:15: laser.inner.offset_m: expected a sequence of 3 numbers (got a sequence of 2 "
+       "items)"},
+      {"laser: 5\n", "x.yaml:1:8: laser: expected a map of keys (got 5)"},
+      {"- 1\n- 2\n", "x.yaml:1:1: expected a map of keys at the top level (got a sequence of 2 items)"},
+  };
+  for (const Case& c : cases) {
+    const std::string message = ErrorOf(c.yaml);
+    EXPECT_TRUE(Contains(message, c.expected)) << "yaml:\n" << c.yaml;
+    EXPECT_EQ(LineCount(message), 1u) << message;
+  }
+}
+
+TEST(ConfigTest, WrongTypeLeavesDefaultAndOtherKeysRead) {
+  // The bad element keeps the whole vector at its default.
+  const std::string message = ErrorOf("laser:\n  gains: [1, x]\n  beam_count: 0\n");
+  EXPECT_TRUE(Contains(message, "laser.gains[1]: expected a number (got x)"));
+  EXPECT_TRUE(Contains(message, "x.yaml:3:15: laser.beam_count: expected a value > 0 (got 0)"));
+}
+
+TEST(ConfigTest, OutOfRangeFromValidatePointsAtValue) {
+  EXPECT_TRUE(Contains(ErrorOf("laser:\n  range_noise_std_m: -1\n"),
+                       "x.yaml:2:22: laser.range_noise_std_m: expected a value >= 0 (got -1)"));
+  EXPECT_TRUE(Contains(ErrorOf("laser:\n  inner:\n    gain: 2\n"),
+                       "x.yaml:3:11: laser.inner.gain: expected a value in [0, 1] (got 2)"));
+  EXPECT_TRUE(Contains(ErrorOf("laser:\n  mode: fast\n"),
+                       "x.yaml:2:9: laser.mode: expected one of exact, noisy (got fast)"));
+  // An element key from Validate ("gains[1]") maps to that element.
+  EXPECT_TRUE(Contains(ErrorOf("laser:\n  gains: [1, -2]\n"),
+                       "x.yaml:2:14: laser.gains[1]: expected a value > 0 (got -2)"));
+}
+
+TEST(ConfigTest, ProblemWithDefaultValueNamesFileOnly) {
+  // min_range_m keeps its default (0.1), which is now >= max_range_m.
+  const std::string message = ErrorOf("max_range_m: 0.05\n");
+  EXPECT_EQ(message, "x.yaml: min_range_m: expected a value < max_range_m (got 0.1)");
+}
+
+TEST(ConfigTest, ReportsEveryProblemInOneThrow) {
+  try {
+    LoadConfigString<ToyParams>(
+        "rate_hz: -1\n"
+        "bogus: 1\n"
+        "laser:\n"
+        "  beam_count: x\n"
+        "  seed: 1\n"
+        "  seed: 2\n"
+        "  range_noise_std_m: -0.5\n",
+        "x.yaml", {"laser.inner.gain=7"});
+    FAIL() << "no ConfigError";
+  } catch (const ConfigError& error) {
+    const std::string message = error.what();
+    EXPECT_EQ(error.problems().size(), 6u) << message;
+    EXPECT_EQ(LineCount(message), 6u) << message;
+    // Text order, then the --set option.
+    EXPECT_EQ(error.problems().front().key, "rate_hz");
+    EXPECT_EQ(error.problems().back().key, "laser.inner.gain");
+    EXPECT_TRUE(Contains(message, "x.yaml:2:1: bogus: unknown key"));
+    EXPECT_TRUE(Contains(message, "x.yaml:4:15: laser.beam_count: expected an integer (got x)"));
+    EXPECT_TRUE(Contains(message, "x.yaml:6:3: laser.seed: duplicate key"));
+    EXPECT_TRUE(Contains(message, "x.yaml:1:10: rate_hz: expected a value > 0 (got -1)"));
+    EXPECT_TRUE(Contains(message,
+                         "x.yaml:7:22: laser.range_noise_std_m: expected a value >= 0 (got -0.5)"));
+    EXPECT_TRUE(Contains(message, "--set laser.inner.gain=7: laser.inner.gain: expected a value in "
+                                  "[0, 1] (got 7)"));
+  }
+}
+
+TEST(ConfigTest, ConfigErrorIsRuntimeError) {
+  EXPECT_THROW(LoadConfigString<ToyParams>("rate_hz: 0\n", "x.yaml"), std::runtime_error);
+}
+
+TEST(ConfigTest, OverrideSetsScalarNestedAndFlowSequence) {
+  const ToyParams params = LoadConfigString<ToyParams>(
+      "rate_hz: 1\nlaser:\n  range_noise_std_m: 0.5\n  beam_count: 7\n", "x.yaml",
+      {"rate_hz=5", "laser.range_noise_std_m=0", "laser.waypoints=[[0,0],[1,2]]",
+       "laser.mode=noisy", "laser.inner.offset_m=[1, 2, 3]"});
+  EXPECT_EQ(params.rate_hz, 5.0);
+  EXPECT_EQ(params.laser.range_noise_std_m, 0.0);
+  EXPECT_EQ(params.laser.beam_count, 7);  // untouched file value
+  ASSERT_EQ(params.laser.waypoints.size(), 2u);
+  EXPECT_EQ(params.laser.waypoints[1][0], 1.0);
+  EXPECT_EQ(params.laser.waypoints[1][1], 2.0);
+  EXPECT_EQ(params.laser.mode, "noisy");
+  EXPECT_EQ(params.laser.inner.offset_m, (std::array<double, 3>{1.0, 2.0, 3.0}));
+}
+
+TEST(ConfigTest, LaterOverrideWinsAndMapOverrideMerges) {
+  const ToyParams params = LoadConfigString<ToyParams>(
+      "laser:\n  range_noise_std_m: 0.5\n  beam_count: 7\n", "x.yaml",
+      {"rate_hz=5", "rate_hz=6", "laser={beam_count: 9}", "laser.inner={gain: 0.25}"});
+  EXPECT_EQ(params.rate_hz, 6.0);
+  EXPECT_EQ(params.laser.beam_count, 9);
+  EXPECT_EQ(params.laser.range_noise_std_m, 0.5);  // kept by the merge
+  EXPECT_EQ(params.laser.inner.gain, 0.25);
+}
+
+TEST(ConfigTest, OverrideOfUnknownKeyNamesSetAndKey) {
+  const std::string message = ErrorOf("laser:\n  beam_count: 7\n", {"laser.beam_cuont=3"});
+  EXPECT_TRUE(Contains(message, "--set laser.beam_cuont=3: laser.beam_cuont: unknown key, did you "
+                                "mean 'beam_count'? (known keys of laser:"));
+  EXPECT_TRUE(Contains(ErrorOf("", {"nothing.here=1"}),
+                       "--set nothing.here=1: nothing: unknown key (known keys: rate_hz,"));
+}
+
+TEST(ConfigTest, OverrideWithBadValueNamesSetAndKey) {
+  EXPECT_EQ(ErrorOf("", {"laser.beam_count=abc"}),
+            "--set laser.beam_count=abc: laser.beam_count: expected an integer (got abc)");
+  EXPECT_EQ(ErrorOf("laser:\n  range_noise_std_m: 1\n", {"laser.range_noise_std_m=-1"}),
+            "--set laser.range_noise_std_m=-1: laser.range_noise_std_m: expected a value >= 0 "
+            "(got -1)");
+  EXPECT_TRUE(Contains(ErrorOf("", {"laser.gains=[1,"}),
+                       "--set laser.gains=[1,: laser.gains: invalid YAML value: "));
+  EXPECT_EQ(ErrorOf("", {"rate_hz"}), "--set rate_hz: expected --set dotted.key=value");
+  EXPECT_EQ(ErrorOf("", {"laser..seed=1"}),
+            "--set laser..seed=1: laser..seed: expected a dotted key like laser.range_noise_std_m");
+  EXPECT_EQ(ErrorOf("", {"laser.waypoints=[[0,0],[1]]"}),
+            "--set laser.waypoints=[[0,0],[1]]: laser.waypoints[1]: expected a sequence of 2 "
+            "numbers (got a sequence of 1 item)");
+}
+
+TEST(ConfigTest, YamlSyntaxErrorHasLineCol) {
+  const std::string message = ErrorOf("rate_hz: 1\nlaser: [1,\nmode: 2\n");
+  // yaml-cpp reports the unclosed flow sequence at the end of the text.
+  EXPECT_TRUE(Contains(message, "x.yaml:4:1: YAML syntax error: end of sequence flow not found"));
+  EXPECT_TRUE(Contains(ErrorOf("laser:\n  seed: 1\n    x: 2\n"), "x.yaml:3:6: YAML syntax error: "));
+}
+
+TEST(ConfigTest, MoreThanOneDocumentRejected) {
+  EXPECT_TRUE(Contains(ErrorOf("rate_hz: 1\n---\nrate_hz: 2\n"),
+                       "x.yaml:3:1: expected one YAML document (found 2)"));
+}
+
+TEST(ConfigTest, RecursiveAliasRejectedNotFollowed) {
+  EXPECT_TRUE(Contains(ErrorOf("laser: &x [*x]\n"), "recursive alias"));
+}
+
+TEST(ConfigTest, MissingFileIsConfigError) {
+  const std::string path = "/nonexistent/mjslam/x.yaml";
+  try {
+    LoadConfigFile<ToyParams>(path);
+    FAIL() << "no ConfigError";
+  } catch (const ConfigError& error) {
+    EXPECT_EQ(std::string(error.what()),
+              path + ": cannot read config file (No such file or directory)");
+  }
+  EXPECT_THROW(LoadConfigFile<ToyParams>(::testing::TempDir()), ConfigError);  // a directory
+}
+
+TEST(ConfigTest, LoadsFileAndNamesItInMessages) {
+  const std::string path = ::testing::TempDir() + "/mjslam_config_test_run.yaml";
+  {
+    std::ofstream out(path);
+    out << "rate_hz: 4\nlaser:\n  range_noise_std_m: 0.25\n";
+  }
+  const ToyParams params = LoadConfigFile<ToyParams>(path, {"laser.seed=7"});
+  EXPECT_EQ(params.rate_hz, 4.0);
+  EXPECT_EQ(params.laser.range_noise_std_m, 0.25);
+  EXPECT_EQ(params.laser.seed, 7u);
+  try {
+    LoadConfigFile<ToyParams>(path, {"laser.range_noise_std_m=x"});
+    FAIL() << "no ConfigError";
+  } catch (const ConfigError& error) {
+    EXPECT_TRUE(Contains(error.what(), "--set laser.range_noise_std_m=x: laser.range_noise_std_m"));
+  }
+  {
+    std::ofstream out(path);
+    out << "rate_hz: 4\nlaser:\n  range_noise_std_m: -0.25\n";
+  }
+  try {
+    LoadConfigFile<ToyParams>(path);
+    FAIL() << "no ConfigError";
+  } catch (const ConfigError& error) {
+    EXPECT_EQ(std::string(error.what()),
+              path + ":3:22: laser.range_noise_std_m: expected a value >= 0 (got -0.25)");
+  }
+  std::filesystem::remove(path);
+}
+
+}  // namespace
+}  // namespace mjslam::config

@@ -1,0 +1,75 @@
+#pragma once
+
+// Helpers shared by the sim tests: inline MJCF worlds written to temporary
+// files, the robot model's path, and a fixture that turns MuJoCo errors and
+// warnings into test failures.
+
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include <unistd.h>
+
+#include <gtest/gtest.h>
+#include <mujoco/mujoco.h>
+
+#include "sim/simulator.h"
+
+namespace mjslam::sim::testing {
+
+/// The shipped robot model.
+inline std::string RobotModelPath() {
+  return std::string(MJSLAM_SOURCE_DIR) + "/models/pioneer3dx.xml";
+}
+
+/// A shipped world by file name (e.g. "room.xml").
+inline std::string WorldPath(const std::string& name) {
+  return std::string(MJSLAM_SOURCE_DIR) + "/worlds/" + name;
+}
+
+/// Writes `text` to `name` in a directory of this test binary's own under the
+/// system temp directory, and returns the file's path.
+inline std::string WriteTempFile(const std::string& name, const std::string& text) {
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() /
+                                    ("mjslam_sim_test_" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::filesystem::path path = dir / name;
+  std::ofstream file(path);
+  file << text;
+  return path.string();
+}
+
+/// A world MJCF: a floor plane, a start site at the origin facing +x, and
+/// `body` inserted into <worldbody>.
+inline std::string WorldXml(const std::string& body,
+                            const std::string& start = "<site name=\"start\" pos=\"0 0 0\"/>") {
+  return "<mujoco model=\"test_world\">\n  <worldbody>\n"
+         "    <geom name=\"floor\" type=\"plane\" size=\"50 50 0.1\"/>\n    " +
+         start + "\n    " + body + "\n  </worldbody>\n</mujoco>\n";
+}
+
+inline void FailOnMujocoError(const char* message) {
+  ADD_FAILURE() << "MuJoCo error: " << message;
+  throw SimError(std::string("MuJoCo error: ") + message);  // must not return to MuJoCo
+}
+
+inline void FailOnMujocoWarning(const char* message) {
+  ADD_FAILURE() << "MuJoCo warning: " << message;
+  throw SimError(std::string("MuJoCo warning: ") + message);
+}
+
+/// Installs MuJoCo error and warning hooks that fail the running test (the
+/// Simulator keeps hooks that are already installed).
+class MujocoTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    mju_user_error = &FailOnMujocoError;
+    mju_user_warning = &FailOnMujocoWarning;
+  }
+  void TearDown() override {
+    mju_user_error = nullptr;
+    mju_user_warning = nullptr;
+  }
+};
+
+}  // namespace mjslam::sim::testing

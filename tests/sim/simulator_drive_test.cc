@@ -1,0 +1,180 @@
+// The simulated Pioneer drives like the real one: it settles at its start
+// pose, drives straight, turns in place, saturates keeping the curvature,
+// follows the kinematics of the point h (the paper's Eq. (6)), and never
+// raises a MuJoCo warning at the chosen timestep and gains.
+
+#include <cmath>
+#include <iostream>
+
+#include <gtest/gtest.h>
+
+#include "common/angles.h"
+#include "common/rng.h"
+#include "sim/diff_drive.h"
+#include "sim/simulator.h"
+#include "tests/sim/sim_test_util.h"
+
+namespace mjslam::sim {
+namespace {
+
+using testing::MujocoTest;
+using testing::RobotModelPath;
+using testing::WorldXml;
+using testing::WriteTempFile;
+
+// A large empty floor: nothing to hit.
+std::string EmptyWorld() { return WriteTempFile("empty_world.xml", WorldXml("")); }
+
+class SimulatorDriveTest : public MujocoTest {};
+
+TEST_F(SimulatorDriveTest, SettlesAtTheStartPoseWithoutBouncing) {
+  const Pose2 start(1.0, -2.0, DegToRad(30.0));
+  Simulator sim(EmptyWorld(), RobotModelPath(), SimParams{}, RobotParams{}, start);
+  EXPECT_DOUBLE_EQ(sim.time_s(), 0.0);
+  const Pose2 settled = sim.X_WR();
+  EXPECT_NEAR(settled.x, start.x, 1e-3);
+  EXPECT_NEAR(settled.y, start.y, 1e-3);
+  EXPECT_NEAR(WrapAngle(settled.theta - start.theta), 0.0, DegToRad(0.05));
+  // At rest, and it stays there.
+  sim.Advance(2.0);
+  const Pose2 later = sim.X_WR();
+  EXPECT_NEAR(later.x, settled.x, 1e-4);
+  EXPECT_NEAR(later.y, settled.y, 1e-4);
+  EXPECT_NEAR(WrapAngle(later.theta - settled.theta), 0.0, 1e-4);
+  EXPECT_NEAR(sim.TrueTwist().v_mps, 0.0, 1e-4);
+  EXPECT_NEAR(sim.TrueTwist().w_radps, 0.0, 1e-4);
+  EXPECT_EQ(sim.CountRobotWorldContacts(), 0);
+}
+
+TEST_F(SimulatorDriveTest, UsesTheWorldStartSiteByDefault) {
+  const std::string world = WriteTempFile(
+      "start_site_world.xml",
+      WorldXml("", "<site name=\"start\" pos=\"2 3 0\" euler=\"0 0 -45\"/>"));
+  Simulator sim(world, RobotModelPath(), SimParams{}, RobotParams{});
+  EXPECT_NEAR(sim.StartPose().x, 2.0, 1e-12);
+  EXPECT_NEAR(sim.StartPose().y, 3.0, 1e-12);
+  EXPECT_NEAR(sim.StartPose().theta, DegToRad(-45.0), 1e-12);
+  EXPECT_NEAR(sim.X_WR().x, 2.0, 1e-3);
+  EXPECT_NEAR(sim.X_WR().y, 3.0, 1e-3);
+  EXPECT_NEAR(sim.X_WR().theta, DegToRad(-45.0), DegToRad(0.05));
+}
+
+TEST_F(SimulatorDriveTest, AdvanceTakesWholeStepsWithoutAccumulatingRoundOff) {
+  Simulator sim(EmptyWorld(), RobotModelPath(), SimParams{}, RobotParams{});
+  for (int i = 0; i < 10; ++i) sim.Advance(0.1);
+  EXPECT_NEAR(sim.time_s(), 1.0, 1e-9);
+  // 0.003 s is 1.5 steps: rounds to 2, and the remainder is carried over.
+  sim.Advance(0.003);
+  EXPECT_NEAR(sim.time_s(), 1.004, 1e-9);
+  sim.Advance(0.003);
+  EXPECT_NEAR(sim.time_s(), 1.006, 1e-9);
+  EXPECT_THROW(sim.Advance(-0.1), SimError);
+}
+
+// Drives straight with `speed` until the point h has covered 5 m; returns the
+// heading change (rad) and the lateral offset (m) from the start line.
+std::pair<double, double> DriveStraightFiveMetres(double speed_mps) {
+  Simulator sim(EmptyWorld(), RobotModelPath(), SimParams{}, RobotParams{}, Pose2(0, 0, 0));
+  sim.SetCommand({speed_mps, 0.0});
+  while (sim.X_WR().x < 5.0 && sim.time_s() < 60.0) sim.Advance(0.1);
+  const Pose2 end = sim.X_WR();
+  EXPECT_GE(end.x, 5.0);
+  return {end.theta, end.y};
+}
+
+TEST_F(SimulatorDriveTest, DrivesStraightFiveMetresWithLessThanOneDegreeOfDrift) {
+  for (const double speed : {0.3, 0.7, 1.2}) {
+    const auto [heading_change, lateral] = DriveStraightFiveMetres(speed);
+    std::cout << "straight 5 m at " << speed << " m/s: heading drift "
+              << RadToDeg(heading_change) << " deg, lateral " << lateral << " m\n";
+    EXPECT_LT(std::abs(heading_change), DegToRad(1.0)) << "speed " << speed;
+    EXPECT_LT(std::abs(lateral), 0.02) << "speed " << speed;
+  }
+}
+
+TEST_F(SimulatorDriveTest, TurnsInPlaceAboutTheAxleCentre) {
+  const RobotParams robot;
+  Simulator sim(EmptyWorld(), RobotModelPath(), SimParams{}, robot, Pose2(0, 0, 0));
+  const Pose2 X_WA_start = sim.X_WR() * Pose2(-robot.control_point_offset_m, 0, 0);
+  const double w = 1.5;
+  sim.SetCommand({0.0, w});
+  sim.Advance(1.0);  // spin up
+  EXPECT_NEAR(sim.TrueTwist().w_radps, w, 0.01 * w);
+  EXPECT_NEAR(sim.TrueTwist().v_mps, 0.0, 0.005);
+  // A further 2 s: the yaw advances by w * 2 and the axle centre stays put,
+  // so the point h moves on a circle of radius a around it.
+  const double yaw_before = sim.X_WR().theta;
+  sim.Advance(2.0);
+  const double yaw_after = sim.X_WR().theta;
+  EXPECT_NEAR(WrapAngle(yaw_after - yaw_before - 2.0 * w), 0.0, DegToRad(1.0));
+  const Pose2 X_WA = sim.X_WR() * Pose2(-robot.control_point_offset_m, 0, 0);
+  const double axle_drift = std::hypot(X_WA.x - X_WA_start.x, X_WA.y - X_WA_start.y);
+  std::cout << "turn in place at " << w << " rad/s for 3 s: axle centre moved " << axle_drift
+            << " m, yaw rate " << sim.TrueTwist().w_radps << " rad/s\n";
+  EXPECT_LT(axle_drift, 0.01);
+  const Eigen::Vector2d h_from_axle = sim.X_WR().translation() - X_WA.translation();
+  EXPECT_NEAR(h_from_axle.norm(), robot.control_point_offset_m, 1e-6);
+}
+
+TEST_F(SimulatorDriveTest, SaturatesKeepingTheCurvatureAndWheelLimits) {
+  const RobotParams robot;
+  Simulator sim(EmptyWorld(), RobotModelPath(), SimParams{}, robot, Pose2(0, 0, 0));
+  const Twist2 wanted{3.0, 2.0};
+  const Twist2 applied = sim.SetCommand(wanted);
+  EXPECT_NEAR(applied.w_radps / applied.v_mps, wanted.w_radps / wanted.v_mps, 1e-12);
+  sim.Advance(1.5);
+  for (const double speed : sim.WheelSpeeds()) {
+    EXPECT_LE(std::abs(speed), robot.max_wheel_speed_radps * 1.001);
+  }
+  // The driven path has the commanded curvature.
+  const Twist2 measured = sim.TrueTwist();
+  EXPECT_NEAR(measured.w_radps / measured.v_mps, wanted.w_radps / wanted.v_mps, 0.01);
+}
+
+TEST_F(SimulatorDriveTest, PointHFollowsTheUnicycleKinematics) {
+  const RobotParams robot;
+  Simulator sim(EmptyWorld(), RobotModelPath(), SimParams{}, robot, Pose2(0.5, 0.2, 0.3));
+  const Twist2 command{0.4, 0.6};
+  sim.SetCommand(command);
+  sim.Advance(1.0);  // reach steady state
+  const Pose2 before = sim.X_WR();
+  sim.Advance(3.0);
+  const Pose2 predicted = MoveControlPoint(before, command, 3.0, robot.control_point_offset_m);
+  const Pose2 actual = sim.X_WR();
+  std::cout << "arc (0.4 m/s, 0.6 rad/s) for 3 s: position error "
+            << std::hypot(actual.x - predicted.x, actual.y - predicted.y) << " m, heading error "
+            << RadToDeg(WrapAngle(actual.theta - predicted.theta)) << " deg\n";
+  EXPECT_NEAR(actual.x, predicted.x, 0.01);
+  EXPECT_NEAR(actual.y, predicted.y, 0.01);
+  EXPECT_NEAR(WrapAngle(actual.theta - predicted.theta), 0.0, DegToRad(1.0));
+}
+
+TEST_F(SimulatorDriveTest, RandomCommandsAtTheLimitsRaiseNoWarning) {
+  // Seeded command sequence: 30 s of 10 Hz steps between the extremes.
+  Rng rng(20240521);
+  Simulator sim(EmptyWorld(), RobotModelPath(), SimParams{}, RobotParams{}, Pose2(0, 0, 0));
+  for (int i = 0; i < 300; ++i) {
+    sim.SetCommand({rng.Gaussian(0.0, 1.0), rng.Gaussian(0.0, 4.0)});
+    ASSERT_NO_THROW(sim.Advance(0.1)) << "seed 20240521, step " << i;
+  }
+  EXPECT_EQ(sim.CountRobotWorldContacts(), 0);
+}
+
+TEST_F(SimulatorDriveTest, AdvanceThrowsWhenTheRobotTipsOver) {
+  // A ramp-like wedge in front of the robot: driving into it at speed lifts
+  // the robot; the simulator reports it instead of continuing silently.
+  const std::string world = WriteTempFile(
+      "wedge_world.xml",
+      WorldXml("<geom name=\"wedge\" type=\"box\" size=\"0.5 2 0.5\" pos=\"1.3 0 0\" "
+               "euler=\"0 -40 0\"/>"));
+  Simulator sim(world, RobotModelPath(), SimParams{}, RobotParams{}, Pose2(0, 0, 0));
+  sim.SetCommand({1.2, 0.0});
+  EXPECT_THROW(
+      {
+        for (int i = 0; i < 50; ++i) sim.Advance(0.1);
+      },
+      SimError);
+}
+
+}  // namespace
+}  // namespace mjslam::sim
