@@ -112,12 +112,16 @@ struct Simulator::Impl {
   std::array<int, 2> wheel_qposadr{-1, -1};
   std::array<int, 2> wheel_dofadr{-1, -1};
   std::array<int, 2> wheel_actuator{-1, -1};
+  std::array<int, 2> wheel_body{-1, -1};
   int laser_site = -1;
   int start_site = -1;
   std::vector<int> tour_sites;
 
   Pose2 X_RS;
   Twist2 command;
+  // Wheel-speed controller: set points (rad/s) and integrated errors (rad).
+  std::array<double, 2> speed_setpoint_radps{0.0, 0.0};
+  std::array<double, 2> speed_error_integral_rad{0.0, 0.0};
   double requested_time_s = 0.0;
   long long steps = 0;
   double rest_height_m = 0.0;
@@ -167,6 +171,19 @@ void Simulator::Impl::Load(const std::string& world_in, const std::string& robot
     throw SimError("world file '" + world_path + "' must not be named " + kSceneFileName);
   }
 
+  // Each file alone first: through an include, MuJoCo's messages lose the
+  // file name and line number.
+  using KindAndPath = std::pair<std::string, std::string>;
+  for (const auto& [kind, path] :
+       {KindAndPath{"world", world_path}, KindAndPath{"robot model", robot_path}}) {
+    char error[1024] = "";
+    mjModel* alone = mj_loadXML(path.c_str(), nullptr, error, sizeof(error));
+    if (alone == nullptr) {
+      throw SimError("cannot load " + kind + " '" + path + "': " + std::string(error));
+    }
+    mj_deleteModel(alone);
+  }
+
   // The wrapper lives (virtually) in the world's directory and includes both
   // files relative to it, so the world's own includes and assets resolve as
   // when it is loaded alone (MuJoCo 2.2 prefixes every include with the main
@@ -174,7 +191,8 @@ void Simulator::Impl::Load(const std::string& world_in, const std::string& robot
   const fs::path world_dir = world.parent_path();
   const std::string robot_relative = fs::relative(robot_file, world_dir).generic_string();
   if (robot_relative.empty()) {
-    throw SimError("cannot reach robot model '" + robot_path + "' from '" + world_dir.string() + "'");
+    throw SimError("cannot reach robot model '" + robot_path + "' from '" +
+                   world_dir.string() + "'");
   }
   scene_xml = "<mujoco model=\"mjslam_scene\">\n  <include file=\"" +
               XmlEscape(world.filename().string()) + "\"/>\n  <include file=\"" +
@@ -214,7 +232,6 @@ void Simulator::Impl::CheckModel() {
   root_dofadr = m->jnt_dofadr[m->body_jntadr[root_body]];
   const std::array<const char*, 2> joint_names{kLeftWheelJoint, kRightWheelJoint};
   const std::array<const char*, 2> motor_names{kLeftWheelMotor, kRightWheelMotor};
-  std::array<int, 2> wheel_body{};
   for (int i = 0; i < 2; ++i) {
     const int joint = mj_name2id(m, mjOBJ_JOINT, joint_names[i]);
     if (joint < 0 || m->jnt_type[joint] != mjJNT_HINGE) {
@@ -312,15 +329,17 @@ void Simulator::Impl::CheckModel() {
   require_match("wheel_radius_m (left)", robot.wheel_radius_m, radius[0]);
   require_match("wheel_radius_m (right)", robot.wheel_radius_m, radius[1]);
   require_match("axle_track_m", robot.axle_track_m, track);
+
+  // The wheel-speed loop's gain must be stable with explicit integration:
+  // kp dt / I < 1, I the wheel's inertia about its axle plus armature.
   for (int i = 0; i < 2; ++i) {
-    const int actuator = wheel_actuator[i];
-    if (m->actuator_ctrllimited[actuator] &&
-        (robot.max_wheel_speed_radps > m->actuator_ctrlrange[2 * actuator + 1] + 1e-6 ||
-         -robot.max_wheel_speed_radps < m->actuator_ctrlrange[2 * actuator] - 1e-6)) {
+    const double inertia =
+        m->dof_armature[wheel_dofadr[i]] + m->body_inertia[3 * wheel_body[i] + 1];
+    if (sim.wheel_speed_kp_nms_per_rad * sim.timestep_s / inertia >= 1.0) {
       std::ostringstream message;
-      message << "RobotParams max_wheel_speed_radps = " << robot.max_wheel_speed_radps
-              << " exceeds the ctrlrange of actuator '" << motor_names[i] << "' in "
-              << robot_context << " (MuJoCo would clip it without keeping the curvature)";
+      message << "SimParams wheel_speed_kp_nms_per_rad = " << sim.wheel_speed_kp_nms_per_rad
+              << " with timestep_s = " << sim.timestep_s << " is unstable for the wheels of "
+              << robot_context << " (inertia " << inertia << " kg m^2): need kp dt / I < 1";
       throw SimError(message.str());
     }
   }
@@ -382,8 +401,8 @@ void Simulator::Impl::Settle() {
   const Pose2 X_WA_placed = X_WA();
   const double placed_height = d->xpos[3 * root_body + 2];
   const long long settle_steps = std::llround(sim.settle_time_s / sim.timestep_s);
-  d->ctrl[wheel_actuator[0]] = 0.0;
-  d->ctrl[wheel_actuator[1]] = 0.0;
+  speed_setpoint_radps = {0.0, 0.0};
+  speed_error_integral_rad = {0.0, 0.0};
   for (long long i = 0; i < settle_steps; ++i) Step();
   const Pose2 X_WA_settled = X_WA();
   rest_height_m = d->xpos[3 * root_body + 2];
@@ -402,6 +421,22 @@ void Simulator::Impl::Settle() {
 }
 
 void Simulator::Impl::Step() {
+  // Wheel-speed PI control, torque clamped to the actuator range; the error
+  // integrates only while the torque is not saturated (or it helps unwind).
+  for (int i = 0; i < 2; ++i) {
+    const int actuator = wheel_actuator[i];
+    const double error = speed_setpoint_radps[i] - d->qvel[wheel_dofadr[i]];
+    const double integral = speed_error_integral_rad[i] + error * m->opt.timestep;
+    const double torque = sim.wheel_speed_kp_nms_per_rad * error +
+                          sim.wheel_speed_ki_nm_per_rad * integral;
+    double applied = torque;
+    if (m->actuator_ctrllimited[actuator]) {
+      applied = std::clamp(torque, m->actuator_ctrlrange[2 * actuator],
+                           m->actuator_ctrlrange[2 * actuator + 1]);
+    }
+    if (applied == torque || error * torque < 0.0) speed_error_integral_rad[i] = integral;
+    d->ctrl[actuator] = applied;
+  }
   mj_step(m, d);
   // The warning handler throws on the first occurrence; this catches warnings
   // when another handler was installed after ours.
@@ -454,9 +489,8 @@ Simulator& Simulator::operator=(Simulator&&) noexcept = default;
 
 Twist2 Simulator::SetCommand(const Twist2& command) {
   const Twist2 applied = SaturateTwist(command, impl_->robot);
-  const sim::WheelSpeeds wheels = WheelSpeedsFromTwist(applied, impl_->robot);
-  impl_->d->ctrl[impl_->wheel_actuator[0]] = wheels.left_radps;
-  impl_->d->ctrl[impl_->wheel_actuator[1]] = wheels.right_radps;
+  const WheelSpeeds wheels = WheelSpeedsFromTwist(applied, impl_->robot);
+  impl_->speed_setpoint_radps = {wheels.left_radps, wheels.right_radps};
   impl_->command = applied;
   return applied;
 }
@@ -499,7 +533,7 @@ std::array<double, 2> Simulator::WheelAngles() const {
   return {impl_->d->qpos[impl_->wheel_qposadr[0]], impl_->d->qpos[impl_->wheel_qposadr[1]]};
 }
 
-std::array<double, 2> Simulator::WheelSpeeds() const {
+std::array<double, 2> Simulator::WheelVelocities() const {
   return {impl_->d->qvel[impl_->wheel_dofadr[0]], impl_->d->qvel[impl_->wheel_dofadr[1]]};
 }
 

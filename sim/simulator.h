@@ -60,10 +60,10 @@ class Simulator {
   /// file is missing or malformed, the world lacks the `start` site, uses
   /// geom group 5 (reserved for the robot), has joints of its own, has
   /// misnumbered tour sites, the robot model lacks a required name or
-  /// disagrees with `robot` (wheel radius or axle track by more than 1 mm,
-  /// or a wheel-speed limit above the actuators' ctrlrange), the start pose
-  /// touches an obstacle, or the robot does not come to rest. Throws ParamError
-  /// for invalid params.
+  /// disagrees with `robot` (wheel radius or axle track by more than 1 mm),
+  /// the wheel-speed gain is unstable at the timestep, the start pose touches
+  /// an obstacle, or the robot does not come to rest. Throws ParamError for
+  /// invalid params.
   Simulator(const std::string& world_path, const std::string& robot_model_path,
             const SimParams& sim, const RobotParams& robot,
             std::optional<Pose2> X_WR_start = std::nullopt);
@@ -76,8 +76,9 @@ class Simulator {
   /// Sets the command (v, w) of frame R (v: the axle centre's speed along the
   /// heading, m/s; w: yaw rate, rad/s; see sim/diff_drive.h), held until the
   /// next call. It is saturated by SaturateTwist (one common factor, so the
-  /// curvature is kept) and turned into wheel-speed set points. Returns the
-  /// saturated command actually applied. The command must be finite (checked).
+  /// curvature is kept) and turned into the set points of the wheel-speed
+  /// controllers (see SimParams). Returns the saturated command actually
+  /// applied. The command must be finite (checked).
   Twist2 SetCommand(const Twist2& command);
 
   /// The saturated command currently applied.
@@ -109,8 +110,8 @@ class Simulator {
   /// Drive wheel hinge angles {left, right}, radians, forward rotation
   /// positive, unwrapped (the encoders' input, see sim/wheel_odometry.h).
   std::array<double, 2> WheelAngles() const;
-  /// Drive wheel speeds {left, right}, rad/s.
-  std::array<double, 2> WheelSpeeds() const;
+  /// Drive wheel angular velocities {left, right}, rad/s (forward positive).
+  std::array<double, 2> WheelVelocities() const;
 
   /// One exact sweep from the `laser` site at the current state: beam i at
   /// bearing laser.AngleMinRad() + i * laser.AngleIncrementRad() in S, cast
@@ -134,8 +135,8 @@ class Simulator {
   /// Number of contacts between robot geoms and world geoms other than
   /// planes (the floor): 0 unless the robot touches an obstacle.
   int CountRobotWorldContacts() const;
-  /// Footprints of the world's obstacle geoms (everything but planes and the
-  /// robot), in the order of the model.
+  /// Footprints of the world's obstacle geoms (everything but planes, height
+  /// fields and the robot), in the order of the model: the ground-truth map.
   std::vector<ObstacleFootprint> Obstacles() const;
 
   /// The robot parameters in use.

@@ -32,8 +32,9 @@ Eigen::Matrix<double, 5, 5> SelectionBlock(const Eigen::Matrix<double, 5, 5>& P_
 }
 
 double SelectionCriterion(const SlamState& state, const MatchedObservation& observation) {
-  return SelectionCriterion(state.InnovationCovariance(observation.feature, observation.R),
-                            observation.R);
+  return SelectionCriterion(
+      state.InnovationCovariance(observation.feature, observation.z, observation.R),
+      observation.R);
 }
 
 int CorrectClassical(SlamState* state, const std::vector<MatchedObservation>& matched) {

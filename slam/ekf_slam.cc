@@ -7,6 +7,7 @@
 #include "common/angles.h"
 #include "common/params.h"
 #include "slam/data_association.h"
+#include "slam/fast_wrap.h"
 #include "slam/motion_model.h"
 
 namespace mjslam::slam {
@@ -124,7 +125,7 @@ std::vector<EkfSlam::Observation> EkfSlam::CollectObservations(
     }
     Observation observation;
     observation.type = FeatureType::kCorner;
-    observation.z = Eigen::Vector2d(corner.range_m, WrapAngle(corner.bearing_rad));
+    observation.z = Eigen::Vector2d(corner.range_m, WrapAngleFast(corner.bearing_rad));
     observation.R = CheckedCovariance(corner.covariance + extra_corner, what + ".covariance");
     observation.p_SA = corner.p_SC;
     observation.p_SB = corner.p_SC;
@@ -144,8 +145,14 @@ Eigen::MatrixXd EkfSlam::MahalanobisDistances(const std::vector<Observation>& ob
     for (int i = 0; i < num_observations; ++i) {
       const Observation& observation = observations[i];
       if (observation.type != state_.feature_type(k)) continue;
-      const Eigen::Vector2d nu = Innovation(observation.z, m.h);
-      const Eigen::Matrix2d S = m.HPHt + observation.R;
+      // A line's prediction in the observation's polar form.
+      Eigen::Vector2d h = m.h;
+      Eigen::Matrix2d HPHt = m.HPHt;
+      if (observation.type == FeatureType::kLine) {
+        AlignLineToObservation(observation.z, &h, nullptr, nullptr, &HPHt);
+      }
+      const Eigen::Vector2d nu = Innovation(observation.z, h);
+      const Eigen::Matrix2d S = HPHt + observation.R;
       // nu^T S^-1 nu with the 2x2 inverse written out.
       const double det = S(0, 0) * S(1, 1) - S(0, 1) * S(1, 0);
       d2(i, k) = (S(1, 1) * nu.x() * nu.x() - (S(0, 1) + S(1, 0)) * nu.x() * nu.y() +

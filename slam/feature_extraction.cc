@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
+#include <limits>
 #include <string_view>
+#include <utility>
 
 #include "common/angles.h"
 #include "common/check.h"
@@ -21,12 +23,19 @@ constexpr double kCovarianceFloor = 1e-12;
 constexpr double kMinPerpendicularNoiseFraction = 0.1;
 // Reweighting passes of the weighted fit after the unweighted one.
 constexpr int kReweightPasses = 2;
+// Returned ranges outside (kMinRangeM, kMaxRangeM) are dropped as corrupt
+// (no laser reports them; they would only overflow the sums).
+constexpr double kMinRangeM = 1e-3;
+constexpr double kMaxRangeM = 1e4;
+// Merge cost of two runs that must not merge.
+constexpr double kNoMerge = std::numeric_limits<double>::infinity();
 
 // One returned beam as a point in S.
 struct ScanPoint {
   double x = 0.0;
   double y = 0.0;
   double range = 0.0;
+  double inverse_range2 = 0.0;  // 1 / range^2
   int beam = 0;
 };
 
@@ -41,6 +50,8 @@ struct NoiseModel {
 struct LineFit {
   double rho = 0.0;
   double alpha = 0.0;
+  double cos_alpha = 1.0;
+  double sin_alpha = 0.0;
   // Covariance of (rho, alpha) from the beam noise alone (no floors).
   Eigen::Matrix2d covariance = Eigen::Matrix2d::Zero();
   bool ok = false;
@@ -65,48 +76,64 @@ double PerpendicularVariance(const ScanPoint& p, double cos_alpha, double sin_al
                              const NoiseModel& noise) {
   const double along_normal = p.x * cos_alpha + p.y * sin_alpha;     // r cos(phi - alpha)
   const double along_line = -p.x * sin_alpha + p.y * cos_alpha;      // r sin(phi - alpha)
-  const double cos2 = along_normal * along_normal / (p.range * p.range);
+  const double cos2 = along_normal * along_normal * p.inverse_range2;
   const double variance =
       noise.range_var * cos2 + noise.bearing_var * along_line * along_line;
   return std::max(variance, noise.min_perpendicular_var);
 }
 
-// Weighted total least squares of points [first, last] in polar form
-// (Arras & Siegwart 1997, Eqs. 4-5, with weights): minimises
-// sum w_i (x_i cos alpha + y_i sin alpha - rho)^2. With `weighted` false all
-// weights are one; otherwise w_i = 1 / PerpendicularVariance at `prior_alpha`.
-// Returns false if the points do not define a direction.
-bool FitOnce(const std::vector<ScanPoint>& points, int first, int last, bool weighted,
-             double prior_alpha, const NoiseModel& noise, double* rho, double* alpha) {
+// Weighted moments of points [first, last] about the first point (for
+// numerical stability): the sums of w, w dx, w dy, w dx^2, w dy^2, w dx dy.
+struct Moments {
+  double x0 = 0.0;
+  double y0 = 0.0;
+  double sw = 0.0;
+  double sx = 0.0;
+  double sy = 0.0;
+  double sxx = 0.0;
+  double syy = 0.0;
+  double sxy = 0.0;
+};
+
+// The moments with unit weights (`weighted` false) or with
+// w_i = 1 / PerpendicularVariance at the normal angle `prior_alpha`.
+Moments Accumulate(const std::vector<ScanPoint>& points, int first, int last, bool weighted,
+                   double prior_alpha, const NoiseModel& noise) {
   const double cos_prior = std::cos(prior_alpha);
   const double sin_prior = std::sin(prior_alpha);
-  // Moments about the first point, for numerical stability.
-  const double x0 = points[first].x;
-  const double y0 = points[first].y;
-  double sw = 0.0, sx = 0.0, sy = 0.0, sxx = 0.0, syy = 0.0, sxy = 0.0;
+  Moments m;
+  m.x0 = points[first].x;
+  m.y0 = points[first].y;
   for (int i = first; i <= last; ++i) {
     const ScanPoint& p = points[i];
     const double w =
         weighted ? 1.0 / PerpendicularVariance(p, cos_prior, sin_prior, noise) : 1.0;
-    const double dx = p.x - x0;
-    const double dy = p.y - y0;
-    sw += w;
-    sx += w * dx;
-    sy += w * dy;
-    sxx += w * dx * dx;
-    syy += w * dy * dy;
-    sxy += w * dx * dy;
+    const double dx = p.x - m.x0;
+    const double dy = p.y - m.y0;
+    m.sw += w;
+    m.sx += w * dx;
+    m.sy += w * dy;
+    m.sxx += w * dx * dx;
+    m.syy += w * dy * dy;
+    m.sxy += w * dx * dy;
   }
-  const double mx = sx / sw;
-  const double my = sy / sw;
-  const double cxx = sxx - sw * mx * mx;
-  const double cyy = syy - sw * my * my;
-  const double cxy = sxy - sw * mx * my;
+  return m;
+}
+
+// Weighted total least squares in polar form from the moments (Arras &
+// Siegwart 1997, Eqs. 4-5, with weights): minimises
+// sum w_i (x_i cos alpha + y_i sin alpha - rho)^2, in canonical form (rho >= 0,
+// alpha in (-pi, pi]). Returns false if the points define no direction.
+bool SolveLine(const Moments& m, double* rho, double* alpha) {
+  const double mx = m.sx / m.sw;
+  const double my = m.sy / m.sw;
+  const double cxx = m.sxx - m.sw * mx * mx;
+  const double cyy = m.syy - m.sw * my * my;
+  const double cxy = m.sxy - m.sw * mx * my;
   if (!(std::abs(cxx) + std::abs(cyy) > 0.0)) return false;
   // The normal direction minimises the weighted scatter across the line.
   double a = 0.5 * std::atan2(-2.0 * cxy, cyy - cxx);
-  double r = (x0 + mx) * std::cos(a) + (y0 + my) * std::sin(a);
-  // Canonical form: rho >= 0, alpha in (-pi, pi].
+  double r = (m.x0 + mx) * std::cos(a) + (m.y0 + my) * std::sin(a);
   if (r < 0.0) {
     r = -r;
     a += kPi;
@@ -117,74 +144,77 @@ bool FitOnce(const std::vector<ScanPoint>& points, int first, int last, bool wei
 }
 
 // Fits points [first, last] and propagates the beam noise to (rho, alpha).
-// The estimate is the fixed point of the reweighted fit (Pfister et al. 2003);
-// its covariance is the inverse Fisher information of the perpendicular
-// residuals d_i = r_i cos(phi_i - alpha) - rho, with gradient
-// (-1, r_i sin(phi_i - alpha)) in (rho, alpha): to first order the same as
-// propagating the beam covariances through the closed form (Arras & Siegwart
-// 1997), and exact in rho because d_i is linear in the ranges.
+// The estimate is the fixed point of the reweighted fit (Pfister et al. 2003):
+// an unweighted fit, then kReweightPasses weighted ones (one from `prior`, the
+// fit of nearly the same points, when given). Its covariance is the inverse
+// Fisher information of the perpendicular residuals
+// d_i = r_i cos(phi_i - alpha) - rho, whose gradient in (rho, alpha) is
+// (-1, t_i) with t_i = r_i sin(phi_i - alpha) the point's coordinate along the
+// line: to first order the same as propagating the beam covariances through
+// the closed form (Arras & Siegwart 1997), and exact in rho because d_i is
+// linear in the ranges. The information uses the weights of the last pass
+// (taken at the previous angle estimate, a second-order difference).
 LineFit FitLine(const std::vector<ScanPoint>& points, int first, int last,
-                const NoiseModel& noise) {
+                const NoiseModel& noise, const LineFit* prior = nullptr) {
   LineFit fit;
   if (last - first + 1 < 2) return fit;
   double rho = 0.0;
   double alpha = 0.0;
-  if (!FitOnce(points, first, last, false, 0.0, noise, &rho, &alpha)) return fit;
-  for (int pass = 0; pass < kReweightPasses; ++pass) {
-    if (!FitOnce(points, first, last, true, alpha, noise, &rho, &alpha)) return fit;
+  int passes = 1;
+  if (prior != nullptr && prior->ok) {
+    alpha = prior->alpha;
+  } else {
+    const Moments unweighted = Accumulate(points, first, last, false, 0.0, noise);
+    if (!SolveLine(unweighted, &rho, &alpha)) return fit;
+    passes = kReweightPasses;
   }
-  // Fisher information of (rho, alpha) at the final estimate.
+  Moments m;
+  for (int pass = 0; pass < passes; ++pass) {
+    m = Accumulate(points, first, last, true, alpha, noise);
+    if (!SolveLine(m, &rho, &alpha)) return fit;
+  }
+  // Fisher information sum w_i [1, -t_i; -t_i, t_i^2] from the moments, with
+  // t_i = t_0 + u_i and u_i = -dx_i sin(alpha) + dy_i cos(alpha).
   const double c = std::cos(alpha);
   const double s = std::sin(alpha);
-  double info_rr = 0.0, info_ra = 0.0, info_aa = 0.0;
-  for (int i = first; i <= last; ++i) {
-    const ScanPoint& p = points[i];
-    const double w = 1.0 / PerpendicularVariance(p, c, s, noise);
-    const double t = -p.x * s + p.y * c;  // r sin(phi - alpha)
-    info_rr += w;
-    info_ra -= w * t;
-    info_aa += w * t * t;
-  }
-  const double det = info_rr * info_aa - info_ra * info_ra;
+  const double t0 = -m.x0 * s + m.y0 * c;
+  const double sum_u = -s * m.sx + c * m.sy;
+  const double sum_uu = s * s * m.sxx - 2.0 * s * c * m.sxy + c * c * m.syy;
+  const double info_rr = m.sw;
+  const double info_ra = -(m.sw * t0 + sum_u);
+  const double info_aa = m.sw * t0 * t0 + 2.0 * t0 * sum_u + sum_uu;
+  // The determinant is translation invariant: sw sum_uu - sum_u^2.
+  const double det = m.sw * sum_uu - sum_u * sum_u;
   if (!(det > 1e-12 * info_rr * info_aa) || !std::isfinite(det)) return fit;
   fit.rho = rho;
   fit.alpha = alpha;
+  fit.cos_alpha = c;
+  fit.sin_alpha = s;
   fit.covariance << info_aa / det, -info_ra / det, -info_ra / det, info_rr / det;
   fit.ok = true;
   return fit;
 }
 
 // Signed distance of a point from a fitted line, metres (positive on the far
-// side from the sensor), and the same in standard deviations of the point's
-// perpendicular noise.
+// side from the sensor).
 double SignedDistance(const LineFit& fit, double x, double y) {
-  return x * std::cos(fit.alpha) + y * std::sin(fit.alpha) - fit.rho;
+  return x * fit.cos_alpha + y * fit.sin_alpha - fit.rho;
 }
+
+// Distance of a point from a fitted line in standard deviations of the
+// point's perpendicular noise.
 double NormalizedResidual(const LineFit& fit, const ScanPoint& p, const NoiseModel& noise) {
-  const double c = std::cos(fit.alpha);
-  const double s = std::sin(fit.alpha);
-  const double d = p.x * c + p.y * s - fit.rho;
-  return std::abs(d) / std::sqrt(PerpendicularVariance(p, c, s, noise));
+  const double d = SignedDistance(fit, p.x, p.y);
+  return std::abs(d) /
+         std::sqrt(PerpendicularVariance(p, fit.cos_alpha, fit.sin_alpha, noise));
 }
 
 // Projection of a point onto a fitted line, in S.
 Eigen::Vector2d ProjectOntoLine(const LineFit& fit, const ScanPoint& p) {
-  const double c = std::cos(fit.alpha);
-  const double s = std::sin(fit.alpha);
+  const double c = fit.cos_alpha;
+  const double s = fit.sin_alpha;
   const double t = -p.x * s + p.y * c;
   return {fit.rho * c - t * s, fit.rho * s + t * c};
-}
-
-// Distance of a point from the chord through two others (or from the first
-// one if they coincide).
-double ChordDistance(const ScanPoint& a, const ScanPoint& b, const ScanPoint& p) {
-  const double ux = b.x - a.x;
-  const double uy = b.y - a.y;
-  const double length = std::hypot(ux, uy);
-  const double px = p.x - a.x;
-  const double py = p.y - a.y;
-  if (length < 1e-12) return std::hypot(px, py);
-  return std::abs(ux * py - uy * px) / length;
 }
 
 // The split step of split-and-merge, splitting at the point farthest from the
@@ -193,10 +223,23 @@ double ChordDistance(const ScanPoint& a, const ScanPoint& b, const ScanPoint& p)
 // point. Appends the runs of [first, last] in order.
 void SplitRun(const std::vector<ScanPoint>& points, int first, int last,
               double split_distance_m, int cluster, std::vector<Segment>* runs) {
+  // Unit chord direction (any direction if the ends coincide: then the
+  // distance is measured across it from the first point).
+  const ScanPoint& a = points[first];
+  double ux = points[last].x - a.x;
+  double uy = points[last].y - a.y;
+  const double length = std::sqrt(ux * ux + uy * uy);
+  if (length > 1e-12) {
+    ux /= length;
+    uy /= length;
+  } else {
+    ux = 1.0;
+    uy = 0.0;
+  }
   int farthest = -1;
   double farthest_distance = split_distance_m;
   for (int i = first + 1; i < last; ++i) {
-    const double d = ChordDistance(points[first], points[last], points[i]);
+    const double d = std::abs(ux * (points[i].y - a.y) - uy * (points[i].x - a.x));
     if (d > farthest_distance) {
       farthest_distance = d;
       farthest = i;
@@ -224,16 +267,23 @@ double MaxDistance(const std::vector<ScanPoint>& points, int first, int last,
   return max_distance;
 }
 
-// Whether the end of `segment` next to a neighbouring line (the first point
-// if `at_first`, else the last) must go: an outlier of its own line, or
-// within the gate of the neighbouring line too (ambiguous near a vertex).
+// Whether point `p` does not belong to the line `fit`: it is an outlier of
+// that line, or it lies within the gate of the neighbouring line too
+// (ambiguous, near a vertex). `neighbour` may be null.
+bool RejectsPoint(const LineFit& fit, const ScanPoint& p, const Segment* neighbour,
+                  const NoiseModel& noise, double gate) {
+  if (NormalizedResidual(fit, p, noise) > gate) return true;
+  return neighbour != nullptr && neighbour->fit.ok &&
+         NormalizedResidual(neighbour->fit, p, noise) <= gate;
+}
+
+// Whether the end of `segment` next to `neighbour` (the first point if
+// `at_first`, else the last) must go; see RejectsPoint.
 bool ShouldTrim(const std::vector<ScanPoint>& points, const Segment& segment,
                 bool at_first, const Segment* neighbour, const NoiseModel& noise,
                 double gate) {
-  const ScanPoint& p = points[at_first ? segment.first : segment.last];
-  if (NormalizedResidual(segment.fit, p, noise) > gate) return true;
-  return neighbour != nullptr && neighbour->fit.ok &&
-         NormalizedResidual(neighbour->fit, p, noise) <= gate;
+  return RejectsPoint(segment.fit, points[at_first ? segment.first : segment.last],
+                      neighbour, noise, gate);
 }
 
 // The line observation of a final segment, with the model-error floor.
@@ -279,6 +329,9 @@ std::vector<ParamProblem> FeatureExtractionParams::Validate() const {
   finite_non_negative("break_noise_sigmas", break_noise_sigmas);
   check.NonNegative("max_missing_beams", max_missing_beams);
   finite_positive("split_distance_m", split_distance_m);
+  // Below a few noise deviations, noise alone splits walls into short pieces.
+  check.Require(!(split_distance_m < 3.0 * range_noise_std_m), "split_distance_m",
+                split_distance_m, "a value >= 3 * range_noise_std_m");
   finite_positive("outlier_gate_sigmas", outlier_gate_sigmas);
   check.Require(min_points >= 2, "min_points", min_points, "a value >= 2");
   finite_non_negative("min_length_m", min_length_m);
@@ -321,7 +374,7 @@ Eigen::Vector2d PointToRangeBearing(const Eigen::Vector2d& p_SC, Eigen::Matrix2d
   if (J != nullptr) {
     *J << p_SC.x() / range, p_SC.y() / range, -p_SC.y() / range2, p_SC.x() / range2;
   }
-  return {range, std::atan2(p_SC.y(), p_SC.x())};
+  return {range, WrapAngle(std::atan2(p_SC.y(), p_SC.x()))};  // atan2 may give -pi
 }
 
 ScanFeatures ExtractFeatures(const LaserScan& scan, const FeatureExtractionParams& params) {
@@ -345,11 +398,25 @@ ScanFeatures ExtractFeatures(const LaserScan& scan, const FeatureExtractionParam
   const int flagged = std::min(beam_count, static_cast<int>(scan.has_return.size()));
   std::vector<ScanPoint> points;
   points.reserve(static_cast<std::size_t>(flagged));
+  // Beam directions by rotating the previous one by the increment, anchored
+  // with an exact sincos every kAnchorBeams beams (rounding stays ~1e-15).
+  constexpr int kAnchorBeams = 16;
+  const double cos_increment = std::cos(increment);
+  const double sin_increment = std::sin(increment);
+  double cos_bearing = 1.0;
+  double sin_bearing = 0.0;
   for (int i = 0; i < flagged; ++i) {
+    if (i % kAnchorBeams == 0) {
+      cos_bearing = std::cos(scan.BeamAngle(i));
+      sin_bearing = std::sin(scan.BeamAngle(i));
+    } else {
+      const double rotated_cos = cos_bearing * cos_increment - sin_bearing * sin_increment;
+      sin_bearing = sin_bearing * cos_increment + cos_bearing * sin_increment;
+      cos_bearing = rotated_cos;
+    }
     const double range = scan.ranges_m[i];
-    if (scan.has_return[i] == 0 || !std::isfinite(range) || range <= 0.0) continue;
-    const double bearing = scan.BeamAngle(i);
-    points.push_back({range * std::cos(bearing), range * std::sin(bearing), range, i});
+    if (scan.has_return[i] == 0 || !(range > kMinRangeM && range < kMaxRangeM)) continue;
+    points.push_back({range * cos_bearing, range * sin_bearing, range, 1.0 / (range * range), i});
   }
   const int point_count = static_cast<int>(points.size());
   if (point_count < params.min_points) return features;
@@ -359,8 +426,13 @@ ScanFeatures ExtractFeatures(const LaserScan& scan, const FeatureExtractionParam
   // of the two ranges so that the test does not depend on the scan direction).
   const double lambda = DegToRad(params.break_min_incidence_deg);
   const double noise_margin = params.break_noise_sigmas * params.range_noise_std_m;
+  const double adjacent_dphi = std::abs(increment);
+  const double adjacent_factor = std::sin(adjacent_dphi) / std::sin(lambda - adjacent_dphi);
   std::vector<Segment> runs;
   runs.reserve(32);
+  // First and last point of each cluster.
+  std::vector<std::pair<int, int>> cluster_bounds;
+  cluster_bounds.reserve(16);
   int cluster_first = 0;
   int cluster = 0;
   const double split_distance = params.split_distance_m;
@@ -374,39 +446,50 @@ ScanFeatures ExtractFeatures(const LaserScan& scan, const FeatureExtractionParam
       if (beam_gap - 1 > params.max_missing_beams || dphi >= lambda) {
         breaks = true;
       } else {
-        const double r_near = std::min(a.range, b.range);
-        const double max_distance =
-            r_near * std::sin(dphi) / std::sin(lambda - dphi) + noise_margin;
-        breaks = std::hypot(b.x - a.x, b.y - a.y) > max_distance;
+        const double factor = beam_gap == 1
+                                  ? adjacent_factor
+                                  : std::sin(dphi) / std::sin(lambda - dphi);
+        const double max_distance = std::min(a.range, b.range) * factor + noise_margin;
+        const double dx = b.x - a.x;
+        const double dy = b.y - a.y;
+        breaks = dx * dx + dy * dy > max_distance * max_distance;
       }
     }
     if (!breaks) continue;
     // Split the finished cluster [cluster_first, i - 1].
     if (i - cluster_first >= params.min_points) {
       SplitRun(points, cluster_first, i - 1, split_distance, cluster, &runs);
+      cluster_bounds.emplace_back(cluster_first, i - 1);
       ++cluster;
     }
     cluster_first = i;
   }
 
   // Merge: neighbouring runs of one cluster whose union is straight within
-  // the split distance become one run (they share their boundary point).
-  std::size_t kept = 0;
-  for (std::size_t i = 0; i < runs.size(); ++i) {
-    if (kept > 0) {
-      Segment& previous = runs[kept - 1];
-      if (previous.cluster == runs[i].cluster && previous.last == runs[i].first) {
-        const LineFit union_fit = FitLine(points, previous.first, runs[i].last, noise);
-        if (union_fit.ok &&
-            MaxDistance(points, previous.first, runs[i].last, union_fit) <= split_distance) {
-          previous.last = runs[i].last;
-          continue;
-        }
-      }
-    }
-    runs[kept++] = runs[i];
+  // the split distance become one run (they share their boundary point). The
+  // straightest union merges first, so that a run split off by a noisy chord
+  // rejoins its own wall rather than the wall across a vertex.
+  std::vector<double> union_cost(runs.size(), 0.0);
+  const auto merge_cost = [&](std::size_t i) {
+    const Segment& a = runs[i];
+    const Segment& b = runs[i + 1];
+    if (a.cluster != b.cluster || a.last != b.first) return kNoMerge;
+    const LineFit fit = FitLine(points, a.first, b.last, noise);
+    if (!fit.ok) return kNoMerge;
+    const double distance = MaxDistance(points, a.first, b.last, fit);
+    return distance <= split_distance ? distance : kNoMerge;
+  };
+  for (std::size_t i = 0; i + 1 < runs.size(); ++i) union_cost[i] = merge_cost(i);
+  while (runs.size() > 1) {
+    const auto best = std::min_element(union_cost.begin(), union_cost.end() - 1);
+    if (*best == kNoMerge) break;
+    const std::size_t i = static_cast<std::size_t>(best - union_cost.begin());
+    runs[i].last = runs[i + 1].last;
+    runs.erase(runs.begin() + static_cast<std::ptrdiff_t>(i) + 1);
+    union_cost.erase(union_cost.begin() + static_cast<std::ptrdiff_t>(i) + 1);
+    if (i + 1 < runs.size()) union_cost[i] = merge_cost(i);
+    if (i > 0) union_cost[i - 1] = merge_cost(i - 1);
   }
-  runs.resize(kept);
 
   // Each point belongs to at most one line: a split point shared by two runs
   // (the point nearest the vertex) goes to neither, so the lines' errors are
@@ -425,28 +508,37 @@ ScanFeatures ExtractFeatures(const LaserScan& scan, const FeatureExtractionParam
     }
   }
 
+  // Neighbouring valid runs of one cluster.
+  const auto valid_before = [&runs](std::size_t i) -> const Segment* {
+    for (std::size_t j = i; j-- > 0;) {
+      if (runs[j].cluster != runs[i].cluster) return nullptr;
+      if (runs[j].valid) return &runs[j];
+    }
+    return nullptr;
+  };
+  const auto valid_after = [&runs](std::size_t i) -> const Segment* {
+    for (std::size_t j = i + 1; j < runs.size(); ++j) {
+      if (runs[j].cluster != runs[i].cluster) return nullptr;
+      if (runs[j].valid) return &runs[j];
+    }
+    return nullptr;
+  };
+  const auto refit = [&](Segment* run) {
+    run->valid = run->Count() >= params.min_points;
+    if (run->valid) {
+      run->fit = FitLine(points, run->first, run->last, noise, &run->fit);
+      run->valid = run->fit.ok;
+    }
+  };
+
   // Trim the ends: outliers of their own line, and points near a vertex that
   // fit the neighbouring line of the same cluster too; refit after each.
   const double gate = params.outlier_gate_sigmas;
   for (std::size_t i = 0; i < runs.size(); ++i) {
     Segment& run = runs[i];
     if (!run.valid) continue;
-    const Segment* before = nullptr;
-    const Segment* after = nullptr;
-    for (std::size_t j = i; j-- > 0;) {
-      if (runs[j].cluster != run.cluster) break;
-      if (runs[j].valid) {
-        before = &runs[j];
-        break;
-      }
-    }
-    for (std::size_t j = i + 1; j < runs.size(); ++j) {
-      if (runs[j].cluster != run.cluster) break;
-      if (runs[j].valid) {
-        after = &runs[j];
-        break;
-      }
-    }
+    const Segment* before = valid_before(i);
+    const Segment* after = valid_after(i);
     bool changed = true;
     while (changed && run.valid) {
       changed = false;
@@ -458,13 +550,29 @@ ScanFeatures ExtractFeatures(const LaserScan& scan, const FeatureExtractionParam
         --run.last;
         changed = true;
       }
-      if (changed) {
-        run.valid = run.Count() >= params.min_points;
-        if (run.valid) {
-          run.fit = FitLine(points, run.first, run.last, noise);
-          run.valid = run.fit.ok;
-        }
-      }
+      if (changed) refit(&run);
+    }
+  }
+
+  // Grow the ends into points that no line holds (split points, runs too
+  // short to be lines): a point joins when it fits the line within the gate
+  // and does not fit the neighbouring line (not ambiguous); refit after each.
+  for (std::size_t i = 0; i < runs.size(); ++i) {
+    Segment& run = runs[i];
+    if (!run.valid) continue;
+    const Segment* before = valid_before(i);
+    const Segment* after = valid_after(i);
+    const int lowest = before != nullptr ? before->last + 1 : cluster_bounds[run.cluster].first;
+    const int highest = after != nullptr ? after->first - 1 : cluster_bounds[run.cluster].second;
+    while (run.valid && run.first > lowest &&
+           !RejectsPoint(run.fit, points[run.first - 1], before, noise, gate)) {
+      --run.first;
+      refit(&run);
+    }
+    while (run.valid && run.last < highest &&
+           !RejectsPoint(run.fit, points[run.last + 1], after, noise, gate)) {
+      ++run.last;
+      refit(&run);
     }
   }
 
@@ -487,9 +595,9 @@ ScanFeatures ExtractFeatures(const LaserScan& scan, const FeatureExtractionParam
     features.lines.push_back(line);
   }
 
-  // Corners: consecutive lines of one cluster (seen without a range jump in
-  // between, so never at an occlusion edge) meeting at a large enough angle,
-  // with both seen segments ending near the intersection.
+  // Corners: consecutive lines of one cluster (no range jump between them)
+  // meeting at a large enough angle, with both seen segments ending near the
+  // intersection and neither running past it (slam/README.md, step 8).
   const double min_sin_angle = std::sin(DegToRad(params.corner_min_angle_deg));
   int previous = -1;
   for (std::size_t i = 0; i < runs.size(); ++i) {
@@ -509,16 +617,24 @@ ScanFeatures ExtractFeatures(const LaserScan& scan, const FeatureExtractionParam
     const double sin_angle = std::abs(std::sin(line_b.alpha_rad - line_a.alpha_rad));
     if (sin_angle < min_sin_angle || sin_angle == 0.0) continue;
 
-    // The vertex, and how far each seen segment ends from it.
+    // The vertex, and how far short of it each seen segment ends (negative:
+    // the segment runs past it). A segment may stop short by the endpoint
+    // distance plus a few point spacings, but run past by the endpoint
+    // distance only: a wall that runs past is one that continues behind an
+    // occluder, where the occluder's face line happens to meet it.
     const Eigen::Vector2d params_a(line_a.rho_m, line_a.alpha_rad);
     const Eigen::Vector2d params_b(line_b.rho_m, line_b.alpha_rad);
     Eigen::Matrix<double, 2, 4> J_vertex;
     const Eigen::Vector2d p_SC = IntersectLines(params_a, params_b, &J_vertex);
+    const double short_of_a = (p_SC - line_a.p_SB).dot((line_a.p_SB - line_a.p_SA).normalized());
+    const double short_of_b = (p_SC - line_b.p_SA).dot((line_b.p_SA - line_b.p_SB).normalized());
     const double tolerance_a = params.corner_max_endpoint_distance_m +
                                params.corner_endpoint_spacings * EndSpacing(points, run_a, false);
     const double tolerance_b = params.corner_max_endpoint_distance_m +
                                params.corner_endpoint_spacings * EndSpacing(points, run_b, true);
-    if ((line_a.p_SB - p_SC).norm() > tolerance_a || (line_b.p_SA - p_SC).norm() > tolerance_b) {
+    const double overshoot = params.corner_max_endpoint_distance_m;
+    if (short_of_a > tolerance_a || short_of_a < -overshoot || short_of_b > tolerance_b ||
+        short_of_b < -overshoot) {
       continue;
     }
 

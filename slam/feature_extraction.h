@@ -28,14 +28,17 @@ struct FeatureExtractionParams {
   double break_min_incidence_deg = 10.0;
   /// `k` in the breakpoint distance above: noise margin in standard deviations.
   double break_noise_sigmas = 3.0;
-  /// No-return beams that a cluster may bridge (0: every no-return beam ends
-  /// a cluster; the breakpoint distance still applies across the gap).
-  int max_missing_beams = 0;
+  /// Consecutive no-return beams that a cluster may bridge (0: every
+  /// no-return beam ends a cluster). The breakpoint distance still applies
+  /// across the gap, with the gap's angle. Bridging keeps a wall whole when a
+  /// few beams lose their echo (laser.dropout_probability in the simulator).
+  int max_missing_beams = 2;
 
   /// Split-and-merge: a run of points is split at its point farthest from the
   /// chord between its ends when that point is farther than this, metres; two
   /// neighbouring runs are merged when every point of their union lies within
-  /// this distance of the union's fitted line.
+  /// this distance of the union's fitted line. At least 3 range noise
+  /// deviations (noise alone would split walls); 6 or more is better.
   double split_distance_m = 0.03;
   /// An end point of a line whose distance to the fitted line exceeds this
   /// many standard deviations of its perpendicular noise is dropped (and the
@@ -57,10 +60,12 @@ struct FeatureExtractionParams {
   /// Two neighbouring lines of one cluster meet at a corner only when the
   /// acute angle between them is at least this, degrees (in [0, 90]).
   double corner_min_angle_deg = 30.0;
-  /// ... and when each line's seen segment ends within this distance of the
-  /// intersection point, metres, plus `corner_endpoint_spacings` times the
-  /// spacing of that line's last two points (beams spread with range and
-  /// incidence, and the points next to the vertex may have been dropped).
+  /// ... and when each line's seen segment stops short of the intersection
+  /// point by at most this distance, metres, plus `corner_endpoint_spacings`
+  /// times the spacing of that line's last two points (beams spread with range
+  /// and incidence, and the points next to the vertex may have been dropped),
+  /// and runs past it by at most this distance (a wall that runs past the
+  /// intersection continues behind an occluder: no vertex).
   double corner_max_endpoint_distance_m = 0.05;
   /// See `corner_max_endpoint_distance_m`; a count of point spacings (>= 0).
   double corner_endpoint_spacings = 3.0;
@@ -102,9 +107,10 @@ struct FeatureExtractionParams {
 ///
 /// Lines are ordered by first beam; corners by the lines they join. Pure: no
 /// state, no randomness. Never throws because of the scan: an empty scan, an
-/// all-no-return scan, non-finite or non-positive ranges (dropped), a zero or
-/// non-finite beam increment, or a `has_return` shorter than `ranges_m`
-/// (missing entries are no-return) give fewer or no features.
+/// all-no-return scan, ranges that are not finite or outside (1 mm, 10 km)
+/// (dropped), a zero or non-finite beam increment, or a `has_return` shorter
+/// than `ranges_m` (missing entries are no-return) give fewer or no features.
+/// A negative beam increment (a clockwise scan) is fine.
 /// Throws ParamError if `params` is invalid.
 ScanFeatures ExtractFeatures(const LaserScan& scan,
                              const FeatureExtractionParams& params);

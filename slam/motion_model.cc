@@ -3,6 +3,7 @@
 #include <cmath>
 
 #include "common/angles.h"
+#include "slam/fast_wrap.h"
 
 namespace mjslam::slam {
 
@@ -17,7 +18,7 @@ Eigen::Vector3d PredictPose(const Eigen::Vector3d& pose_WR, const Eigen::Vector2
   // at the start of the period (forward Euler, as in the paper).
   const Eigen::Vector3d predicted(pose_WR.x() + d * c - a_m * dth * s,
                                   pose_WR.y() + d * s + a_m * dth * c,
-                                  WrapAngle(pose_WR.z() + dth));
+                                  WrapAngleFast(pose_WR.z() + dth));
   if (A != nullptr) {
     A->setIdentity();
     (*A)(0, 2) = -d * s - a_m * dth * c;

@@ -4,6 +4,7 @@
 
 #include "common/angles.h"
 #include "common/check.h"
+#include "slam/fast_wrap.h"
 
 namespace mjslam::slam {
 
@@ -19,7 +20,7 @@ Eigen::Vector3d SensorPose(const Eigen::Vector3d& pose_WR, const Pose2& X_RS,
           0.0, 1.0, dx_W,
           0.0, 0.0, 1.0;
   }
-  return {pose_WR.x() + dx_W, pose_WR.y() + dy_W, WrapAngle(pose_WR.z() + X_RS.theta)};
+  return {pose_WR.x() + dx_W, pose_WR.y() + dy_W, WrapAngleFast(pose_WR.z() + X_RS.theta)};
 }
 
 Eigen::Vector2d CanonicalLine(const Eigen::Vector2d& line, Eigen::Matrix2d* J) {
@@ -28,8 +29,8 @@ Eigen::Vector2d CanonicalLine(const Eigen::Vector2d& line, Eigen::Matrix2d* J) {
     *J << (flip ? -1.0 : 1.0), 0.0,
           0.0, 1.0;
   }
-  if (flip) return {-line.x(), WrapAngle(line.y() + kPi)};
-  return {line.x(), WrapAngle(line.y())};
+  if (flip) return {-line.x(), WrapAngleFast(line.y() + kPi)};
+  return {line.x(), WrapAngleFast(line.y())};
 }
 
 Eigen::Vector2d PredictLine(const Eigen::Vector3d& pose_WR, const Eigen::Vector2d& line_W,
@@ -74,7 +75,7 @@ Eigen::Vector2d PredictCorner(const Eigen::Vector3d& pose_WR, const Eigen::Vecto
   const double range = std::sqrt(q);
 
   // Eq. (7) for the sensor pose.
-  const Eigen::Vector2d z(range, WrapAngle(std::atan2(dy, dx) - pose_WS.z()));
+  const Eigen::Vector2d z(range, WrapAngleFast(std::atan2(dy, dx) - pose_WS.z()));
   if (H_pose != nullptr) {
     Eigen::Matrix<double, 2, 3> H_sensor;
     H_sensor << -dx / range, -dy / range, 0.0,
@@ -142,6 +143,20 @@ Eigen::Vector2d InitializeCorner(const Eigen::Vector3d& pose_WR, const Eigen::Ve
             s, range * c;
   }
   return p_WC;
+}
+
+bool AlignLineToObservation(const Eigen::Vector2d& z, Eigen::Vector2d* h,
+                            Eigen::Matrix<double, 2, 3>* H_pose, Eigen::Matrix2d* H_feature,
+                            Eigen::Matrix2d* HPHt) {
+  if (std::abs(WrapAngleFast(z.y() - h->y())) <= kPi / 2.0) return false;
+  *h = Eigen::Vector2d(-h->x(), WrapAngleFast(h->y() + kPi));
+  if (H_pose != nullptr) H_pose->row(0) *= -1.0;
+  if (H_feature != nullptr) H_feature->row(0) *= -1.0;
+  if (HPHt != nullptr) {
+    (*HPHt)(0, 1) = -(*HPHt)(0, 1);
+    (*HPHt)(1, 0) = -(*HPHt)(1, 0);
+  }
+  return true;
 }
 
 Eigen::Vector2d PredictObservation(FeatureType type, const Eigen::Vector3d& pose_WR,

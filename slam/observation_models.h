@@ -4,6 +4,7 @@
 
 #include "common/angles.h"
 #include "common/pose2.h"
+#include "slam/fast_wrap.h"
 
 namespace mjslam::slam {
 
@@ -69,11 +70,27 @@ Eigen::Vector2d InitializeFeature(FeatureType type, const Eigen::Vector3d& pose_
                                   Eigen::Matrix<double, 2, 3>* G_pose = nullptr,
                                   Eigen::Matrix2d* G_z = nullptr);
 
+/// Puts a line prediction h (with its Jacobians, when not null) in the polar
+/// form of the observation z it is compared with: if their alphas differ by
+/// more than pi/2, h becomes the same line's other form (-rho, alpha + pi)
+/// and the rho rows of `H_pose`, `H_feature` and the sign of the off-diagonal
+/// of `HPHt` (H P H^T) change. Returns whether it flipped.
+///
+/// Why: canonical forms (rho >= 0) jump by pi in alpha when the sensor
+/// crosses the line (rho = 0); a sensor near a wall's extension can see the
+/// line on one side while the estimate puts it on the other. Differencing the
+/// aligned forms is continuous there; away from rho = 0 it is exactly the
+/// canonical difference of method.md (both forms then agree within pi/2).
+bool AlignLineToObservation(const Eigen::Vector2d& z, Eigen::Vector2d* h,
+                            Eigen::Matrix<double, 2, 3>* H_pose = nullptr,
+                            Eigen::Matrix2d* H_feature = nullptr,
+                            Eigen::Matrix2d* HPHt = nullptr);
+
 /// The innovation z - h of either model: the first components subtracted,
-/// the second (an angle) subtracted and wrapped to (-pi, pi]. Both z and h of
-/// a line must be canonical.
+/// the second (an angle) subtracted and wrapped to (-pi, pi]. A line's h must
+/// be in z's polar form (AlignLineToObservation).
 inline Eigen::Vector2d Innovation(const Eigen::Vector2d& z, const Eigen::Vector2d& h) {
-  return {z.x() - h.x(), WrapAngle(z.y() - h.y())};
+  return {z.x() - h.x(), WrapAngleFast(z.y() - h.y())};
 }
 
 }  // namespace mjslam::slam

@@ -49,11 +49,4 @@ std::vector<ParamProblem> EkfParams::Validate() const {
   return check.problems();
 }
 
-std::vector<ParamProblem> SlamParams::Validate() const {
-  ParamChecker check;
-  check.Merge("features", features.Validate());
-  check.Merge("ekf", ekf.Validate());
-  return check.problems();
-}
-
 }  // namespace mjslam::slam

@@ -151,7 +151,12 @@ struct SlamParams {
     a->Visit(MJSLAM_NVP(ekf));
   }
   /// Problems of both parts, keys prefixed `features.` and `ekf.`.
-  std::vector<ParamProblem> Validate() const;
+  std::vector<ParamProblem> Validate() const {
+    ParamChecker check;
+    check.Merge("features", features.Validate());
+    check.Merge("ekf", ekf.Validate());
+    return check.problems();
+  }
   /// Throws ParamError listing every problem of Validate().
   void ValidateOrThrow() const { ThrowIfProblems(Validate()); }
 };

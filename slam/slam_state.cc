@@ -5,6 +5,7 @@
 
 #include "common/angles.h"
 #include "common/check.h"
+#include "slam/fast_wrap.h"
 
 namespace mjslam::slam {
 namespace {
@@ -25,7 +26,7 @@ constexpr double kMinCornerRange = 1e-9;
 SlamState::SlamState(const Eigen::Vector3d& pose_WR, const Eigen::Matrix3d& pose_covariance,
                      const Pose2& X_RS)
     : X_RS_(X_RS), x_(pose_WR) {
-  x_.z() = WrapAngle(x_.z());
+  x_.z() = WrapAngleFast(x_.z());
   const int capacity = PaddedSize(3 + 2 * kInitialFeatureCapacity);
   P_ = Eigen::MatrixXd::Zero(capacity, capacity);
   P_.topLeftCorner<3, 3>() = 0.5 * (pose_covariance + pose_covariance.transpose());
@@ -86,8 +87,17 @@ SlamState::Measurement SlamState::Measure(int k) const {
   return m;
 }
 
-Eigen::Matrix2d SlamState::InnovationCovariance(int k, const Eigen::Matrix2d& R) const {
-  const Measurement m = Measure(k);
+SlamState::Measurement SlamState::MeasureFor(int k, const Eigen::Vector2d& z) const {
+  Measurement m = Measure(k);
+  if (m.valid && types_[k] == FeatureType::kLine) {
+    AlignLineToObservation(z, &m.h, &m.H_pose, &m.H_feature, &m.HPHt);
+  }
+  return m;
+}
+
+Eigen::Matrix2d SlamState::InnovationCovariance(int k, const Eigen::Vector2d& z,
+                                                const Eigen::Matrix2d& R) const {
+  const Measurement m = MeasureFor(k, z);
   MJSLAM_CHECK(m.valid);
   return m.HPHt + R;
 }
@@ -134,8 +144,9 @@ void SlamState::Update(int k, const Eigen::Vector2d& z, const Eigen::Matrix2d& R
   const Eigen::Vector3d pose_WR = pose();
   Eigen::Matrix<double, 2, 3> H_pose;
   Eigen::Matrix2d H_feature;
-  const Eigen::Vector2d h = PredictObservation(types_[k], pose_WR, feature(k), X_RS_, &H_pose,
-                                               &H_feature);
+  Eigen::Vector2d h = PredictObservation(types_[k], pose_WR, feature(k), X_RS_, &H_pose,
+                                         &H_feature);
+  if (types_[k] == FeatureType::kLine) AlignLineToObservation(z, &h, &H_pose, &H_feature);
   const Eigen::Vector2d nu = Innovation(z, h);
 
   const int n = n_;
@@ -217,11 +228,11 @@ void SlamState::Update(int k, const Eigen::Vector2d& z, const Eigen::Matrix2d& R
   }
 
   // Angles back into (-pi, pi].
-  x_.z() = WrapAngle(x_.z());
+  x_.z() = WrapAngleFast(x_.z());
   for (int f = 0; f < num_features(); ++f) {
     if (types_[f] != FeatureType::kLine) continue;
     double& al = x[FeatureIndex(f) + 1];
-    if (al > kPi || al <= -kPi) al = WrapAngle(al);
+    al = WrapAngleFast(al);
   }
 }
 

@@ -83,8 +83,12 @@ class SlamState {
   /// `a_m` ahead of the axle. O(n): only the pose rows and columns change.
   void Predict(const MotionInput& input, double a_m);
 
-  /// Predicted measurement of feature k at the current mean. O(1).
+  /// Predicted measurement of feature k at the current mean, canonical for
+  /// lines. O(1).
   Measurement Measure(int k) const;
+  /// Measure(k) for comparison with observation z: a line's prediction in
+  /// z's polar form (AlignLineToObservation). O(1).
+  Measurement MeasureFor(int k, const Eigen::Vector2d& z) const;
 
   /// Augments the state with a feature initialised from observation z with
   /// covariance R (2x2 SPD) by the inverse observation model g:
@@ -94,16 +98,19 @@ class SlamState {
   int AddFeature(FeatureType type, const Eigen::Vector2d& z, const Eigen::Matrix2d& R);
 
   /// One sequential EKF correction (Algorithm 1, sentences iv-vi) with
-  /// observation z (canonical for lines) of feature k, covariance R (SPD):
-  ///   nu = z - h(xi) (angle wrapped), S = H P H^T + R, K = P H^T S^-1,
+  /// observation z of feature k, covariance R (SPD):
+  ///   nu = z - h(xi) (angle wrapped; a line's h in z's polar form),
+  ///   S = H P H^T + R, K = P H^T S^-1,
   ///   xi <- xi + K nu,  P <- P - K S K^T = P - V V^T with V = P H^T L^-T,
   ///   S = L L^T. P H^T uses 5 columns of P; the downdate is O(n^2) with no
   ///   dense n x n product. Angles are wrapped afterwards. Precondition
   ///   (checked): Measure(k).valid and S positive definite.
   void Update(int k, const Eigen::Vector2d& z, const Eigen::Matrix2d& R);
 
-  /// The innovation covariance S = H P H^T + R of observation (k, R). O(1).
-  Eigen::Matrix2d InnovationCovariance(int k, const Eigen::Matrix2d& R) const;
+  /// The innovation covariance S = H P H^T + R of observation z of feature k
+  /// with covariance R. O(1).
+  Eigen::Matrix2d InnovationCovariance(int k, const Eigen::Vector2d& z,
+                                       const Eigen::Matrix2d& R) const;
 
  private:
   // Makes room for `n` state entries, doubling the buffer if needed.

@@ -27,11 +27,16 @@ inline std::string WorldPath(const std::string& name) {
   return std::string(MJSLAM_SOURCE_DIR) + "/worlds/" + name;
 }
 
-/// Writes `text` to `name` in a directory of this test binary's own under the
-/// system temp directory, and returns the file's path.
+/// This test process's own directory for inline worlds, under the system's
+/// temp directory (removed by MujocoTest::TearDown).
+inline std::filesystem::path TempDir() {
+  return std::filesystem::temp_directory_path() /
+         ("mjslam_sim_test_" + std::to_string(::getpid()));
+}
+
+/// Writes `text` to `name` in TempDir() and returns the file's path.
 inline std::string WriteTempFile(const std::string& name, const std::string& text) {
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() /
-                                    ("mjslam_sim_test_" + std::to_string(::getpid()));
+  const std::filesystem::path dir = TempDir();
   std::filesystem::create_directories(dir);
   const std::filesystem::path path = dir / name;
   std::ofstream file(path);
@@ -59,7 +64,8 @@ inline void FailOnMujocoWarning(const char* message) {
 }
 
 /// Installs MuJoCo error and warning hooks that fail the running test (the
-/// Simulator keeps hooks that are already installed).
+/// Simulator keeps hooks that are already installed), and removes the test's
+/// temporary files afterwards.
 class MujocoTest : public ::testing::Test {
  protected:
   void SetUp() override {
@@ -69,6 +75,8 @@ class MujocoTest : public ::testing::Test {
   void TearDown() override {
     mju_user_error = nullptr;
     mju_user_warning = nullptr;
+    std::error_code ignored;
+    std::filesystem::remove_all(TempDir(), ignored);
   }
 };
 

@@ -12,6 +12,7 @@
 #include "common/rng.h"
 #include "sim/diff_drive.h"
 #include "sim/simulator.h"
+#include "sim/wheel_odometry.h"
 #include "tests/sim/sim_test_util.h"
 
 namespace mjslam::sim {
@@ -63,10 +64,11 @@ TEST_F(SimulatorDriveTest, AdvanceTakesWholeStepsWithoutAccumulatingRoundOff) {
   Simulator sim(EmptyWorld(), RobotModelPath(), SimParams{}, RobotParams{});
   for (int i = 0; i < 10; ++i) sim.Advance(0.1);
   EXPECT_NEAR(sim.time_s(), 1.0, 1e-9);
-  // 0.003 s is 1.5 steps: rounds to 2, and the remainder is carried over.
-  sim.Advance(0.003);
+  // 0.0031 s is 1.55 steps: rounds to 2, and the remainder is carried over
+  // (0.0062 s in all is 3.1 steps: one more).
+  sim.Advance(0.0031);
   EXPECT_NEAR(sim.time_s(), 1.004, 1e-9);
-  sim.Advance(0.003);
+  sim.Advance(0.0031);
   EXPECT_NEAR(sim.time_s(), 1.006, 1e-9);
   EXPECT_THROW(sim.Advance(-0.1), SimError);
 }
@@ -123,7 +125,7 @@ TEST_F(SimulatorDriveTest, SaturatesKeepingTheCurvatureAndWheelLimits) {
   const Twist2 applied = sim.SetCommand(wanted);
   EXPECT_NEAR(applied.w_radps / applied.v_mps, wanted.w_radps / wanted.v_mps, 1e-12);
   sim.Advance(1.5);
-  for (const double speed : sim.WheelSpeeds()) {
+  for (const double speed : sim.WheelVelocities()) {
     EXPECT_LE(std::abs(speed), robot.max_wheel_speed_radps * 1.001);
   }
   // The driven path has the commanded curvature.
@@ -160,20 +162,83 @@ TEST_F(SimulatorDriveTest, RandomCommandsAtTheLimitsRaiseNoWarning) {
   EXPECT_EQ(sim.CountRobotWorldContacts(), 0);
 }
 
-TEST_F(SimulatorDriveTest, AdvanceThrowsWhenTheRobotTipsOver) {
-  // A ramp-like wedge in front of the robot: driving into it at speed lifts
-  // the robot; the simulator reports it instead of continuing silently.
+TEST_F(SimulatorDriveTest, NoiselessOdometryFromTheWheelAnglesTracksTheTruePose) {
+  // The encoders read the simulated wheels: forward is positive on both, and
+  // the only odometry error left is the tyres' creep in the soft contacts.
+  const RobotParams robot;
+  OdometryParams params;
+  params.slip_std_fraction = 0.0;
+  Simulator sim(EmptyWorld(), RobotModelPath(), SimParams{}, robot, Pose2(1, 2, 0.5));
+  WheelOdometry odometry(robot, params, Rng(1));
+  odometry.Update(sim.WheelAngles());
+  const Pose2 X_WO = sim.X_WR();
+  double driven = 0.0;
+  for (int i = 0; i < 200; ++i) {
+    sim.SetCommand({0.5, 0.8 * std::sin(0.05 * i)});
+    const Pose2 before = sim.X_WR();
+    sim.Advance(0.1);
+    driven += std::hypot(sim.X_WR().x - before.x, sim.X_WR().y - before.y);
+    odometry.Update(sim.WheelAngles());
+  }
+  const Pose2 X_OR_true = X_WO.Inverse() * sim.X_WR();
+  const Pose2 X_OR = odometry.X_OR();
+  const double position_error = std::hypot(X_OR.x - X_OR_true.x, X_OR.y - X_OR_true.y);
+  std::cout << "odometry after " << driven << " m of S-curves: position error " << position_error
+            << " m, heading error " << RadToDeg(WrapAngle(X_OR.theta - X_OR_true.theta))
+            << " deg\n";
+  EXPECT_LT(position_error, 0.01 * driven);
+  EXPECT_NEAR(WrapAngle(X_OR.theta - X_OR_true.theta), 0.0, DegToRad(1.0));
+}
+
+TEST_F(SimulatorDriveTest, SameInputsGiveBitIdenticalRuns) {
+  const auto run = []() {
+    Simulator sim(EmptyWorld(), RobotModelPath(), SimParams{}, RobotParams{}, Pose2(0, 0, 0));
+    Rng rng(3);
+    for (int i = 0; i < 50; ++i) {
+      sim.SetCommand({rng.Gaussian(0.3, 0.3), rng.Gaussian(0.0, 1.0)});
+      sim.Advance(0.1);
+    }
+    return sim.QPos();
+  };
+  EXPECT_EQ(run(), run());
+}
+
+TEST_F(SimulatorDriveTest, DrivingIntoAWallStopsTheRobotWithoutWarnings) {
+  // Full speed into a wall, head on and at 30 degrees: the robot stops at the
+  // wall, stays on the floor, and the contacts are reported.
   const std::string world = WriteTempFile(
-      "wedge_world.xml",
-      WorldXml("<geom name=\"wedge\" type=\"box\" size=\"0.5 2 0.5\" pos=\"1.3 0 0\" "
-               "euler=\"0 -40 0\"/>"));
-  Simulator sim(world, RobotModelPath(), SimParams{}, RobotParams{}, Pose2(0, 0, 0));
-  sim.SetCommand({1.2, 0.0});
-  EXPECT_THROW(
-      {
-        for (int i = 0; i < 50; ++i) sim.Advance(0.1);
-      },
-      SimError);
+      "crash_world.xml",
+      WorldXml("<geom name=\"wall\" type=\"box\" size=\"0.1 3 0.5\" pos=\"2.1 0 0.5\"/>"));
+  for (const double yaw : {0.0, DegToRad(30.0)}) {
+    Simulator sim(world, RobotModelPath(), SimParams{}, RobotParams{}, Pose2(0, 0, yaw));
+    sim.SetCommand({1.2, 0.0});
+    ASSERT_NO_THROW(sim.Advance(4.0)) << "yaw " << yaw;
+    EXPECT_GT(sim.CountRobotWorldContacts(), 0);
+    // The chassis front (0.18 m ahead of the axle) is at the wall face (x = 2).
+    const Pose2 X_WA = sim.X_WR() * Pose2(-0.2, 0.0, 0.0);
+    EXPECT_LT(X_WA.x, 2.0 - 0.17 * std::cos(X_WA.theta));
+    sim.SetCommand({-0.3, 0.0});
+    ASSERT_NO_THROW(sim.Advance(1.0));
+    EXPECT_EQ(sim.CountRobotWorldContacts(), 0);
+  }
+}
+
+TEST_F(SimulatorDriveTest, AdvanceThrowsWhenTheRobotLeavesTheFloorPlane) {
+  // A 15 degree ramp whose top face meets the floor at x = 1 m: the robot
+  // climbs it, which breaks the flat-world assumption, and Advance says so.
+  const std::string world = WriteTempFile(
+      "ramp_world.xml",
+      WorldXml("<geom name=\"ramp\" type=\"box\" size=\"2 2 0.5\" "
+               "pos=\"3.0614 0 0.0346\" euler=\"0 -15 0\"/>"));
+  Simulator sim(world, RobotModelPath(), SimParams{}, RobotParams{}, Pose2(0.2, 0, 0));
+  sim.SetCommand({0.5, 0.0});
+  try {
+    for (int i = 0; i < 100; ++i) sim.Advance(0.1);
+    FAIL() << "no SimError; robot at x = " << sim.X_WR().x;
+  } catch (const SimError& error) {
+    EXPECT_NE(std::string(error.what()).find("left the floor"), std::string::npos)
+        << error.what();
+  }
 }
 
 }  // namespace

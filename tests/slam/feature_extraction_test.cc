@@ -214,6 +214,17 @@ TEST(FeatureExtractionParamsTest, ReportsEveryBadField) {
   EXPECT_THROW(ExtractFeatures(LaserScan(), params), ParamError);
 }
 
+TEST(FeatureExtractionParamsTest, RequiresSplitDistanceAboveTheNoise) {
+  FeatureExtractionParams params;
+  params.range_noise_std_m = 0.02;
+  params.split_distance_m = 0.05;
+  const std::vector<ParamProblem> problems = params.Validate();
+  ASSERT_EQ(problems.size(), 1u);
+  EXPECT_EQ(problems[0].key, "split_distance_m");
+  params.split_distance_m = 0.06;
+  EXPECT_TRUE(params.Validate().empty());
+}
+
 // An archive that records the visited names.
 struct NameRecorder {
   std::vector<std::string> names;
@@ -349,6 +360,64 @@ TEST(ExtractFeaturesTest, OddScansGiveNoFeaturesAndDoNotThrow) {
   }
 }
 
+// Garbage scans (random sizes, ranges, flags and increments, with NaN, inf,
+// negative, tiny and huge ranges mixed in) never throw, and whatever comes out
+// is well formed: finite, canonical, symmetric positive definite, with valid
+// indices. Seed printed.
+TEST(ExtractFeaturesTest, GarbageScansGiveWellFormedFeatures) {
+  const std::uint64_t seed = 20240609;
+  Rng rng(seed);
+  const double odd_ranges[] = {std::numeric_limits<double>::quiet_NaN(),
+                               std::numeric_limits<double>::infinity(),
+                               -std::numeric_limits<double>::infinity(),
+                               -1.0,
+                               0.0,
+                               1e-300,
+                               1e300,
+                               std::numeric_limits<double>::denorm_min()};
+  int lines = 0;
+  for (int k = 0; k < 2000; ++k) {
+    LaserScan scan;
+    const int beams = static_cast<int>(400 * rng.Uniform());
+    scan.angle_min_rad = 4.0 * rng.Uniform() - 2.0;
+    scan.angle_increment_rad = rng.Bernoulli(0.1) ? 0.0 : 0.1 * (2.0 * rng.Uniform() - 1.0);
+    scan.max_range_m = 30.0;
+    // Piecewise-smooth ranges (so that some lines appear) with odd values.
+    double range = 5.0 * rng.Uniform();
+    for (int i = 0; i < beams; ++i) {
+      if (rng.Bernoulli(0.05)) range = 40.0 * rng.Uniform();
+      range += 0.02 * (2.0 * rng.Uniform() - 1.0);
+      scan.ranges_m.push_back(rng.Bernoulli(0.03) ? odd_ranges[static_cast<int>(8 * rng.Uniform())]
+                                                  : range);
+      scan.has_return.push_back(rng.Bernoulli(0.9) ? 1 : 0);
+    }
+    if (rng.Bernoulli(0.1)) scan.has_return.resize(beams / 2);
+    ScanFeatures features;
+    ASSERT_NO_THROW(features = ExtractFeatures(scan, FeatureExtractionParams())) << "scan " << k;
+    for (const LineObservation& line : features.lines) {
+      ++lines;
+      EXPECT_TRUE(std::isfinite(line.rho_m) && line.rho_m >= 0.0) << "scan " << k;
+      EXPECT_TRUE(line.alpha_rad > -kPi && line.alpha_rad <= kPi) << "scan " << k;
+      EXPECT_TRUE(IsSymmetricPositiveDefinite(line.covariance)) << "scan " << k;
+      EXPECT_TRUE(line.p_SA.allFinite() && line.p_SB.allFinite()) << "scan " << k;
+      EXPECT_TRUE(line.first_beam >= 0 && line.first_beam < line.last_beam &&
+                  line.last_beam < scan.size())
+          << "scan " << k;
+    }
+    for (const CornerObservation& corner : features.corners) {
+      EXPECT_TRUE(std::isfinite(corner.range_m) && corner.range_m > 0.0) << "scan " << k;
+      EXPECT_TRUE(corner.bearing_rad > -kPi && corner.bearing_rad <= kPi) << "scan " << k;
+      EXPECT_TRUE(IsSymmetricPositiveDefinite(corner.covariance)) << "scan " << k;
+      EXPECT_TRUE(corner.line_a >= 0 && corner.line_a < corner.line_b &&
+                  corner.line_b < static_cast<int>(features.lines.size()))
+          << "scan " << k;
+    }
+  }
+  std::printf("seed %llu: %d lines from 2000 garbage scans\n",
+              static_cast<unsigned long long>(seed), lines);
+  EXPECT_GT(lines, 100);  // the scans are not all rejected outright
+}
+
 TEST(ExtractFeaturesTest, AllNoReturnScanGivesNoFeatures) {
   // A wall exactly at the maximum range: beams hit it at or beyond max range,
   // so they report max_range_m with has_return 0.
@@ -414,8 +483,10 @@ TEST(ExtractFeaturesTest, NoReturnBeamsAreDroppedAndBreakTheWall) {
     cast.scan.ranges_m[i] = cast.scan.max_range_m;
     cast.scan.has_return[i] = 0;
   }
-  // Default: a no-return beam ends the cluster, so two lines, both exact.
-  const ScanFeatures split = ExtractFeatures(cast.scan, FeatureExtractionParams());
+  // A gap wider than max_missing_beams ends the cluster: two lines, both exact.
+  FeatureExtractionParams params;
+  params.max_missing_beams = 4;
+  const ScanFeatures split = ExtractFeatures(cast.scan, params);
   ASSERT_EQ(split.lines.size(), 2u);
   EXPECT_LT(split.lines[0].last_beam, 88);
   EXPECT_GT(split.lines[1].first_beam, 92);
@@ -426,14 +497,36 @@ TEST(ExtractFeaturesTest, NoReturnBeamsAreDroppedAndBreakTheWall) {
   EXPECT_TRUE(split.corners.empty());
 
   // Bridging the gap: one line over both parts, still exact.
-  FeatureExtractionParams bridging;
-  bridging.max_missing_beams = 5;
-  const ScanFeatures joined = ExtractFeatures(cast.scan, bridging);
+  params.max_missing_beams = 5;
+  const ScanFeatures joined = ExtractFeatures(cast.scan, params);
   ASSERT_EQ(joined.lines.size(), 1u);
   EXPECT_LT(joined.lines[0].first_beam, 88);
   EXPECT_GT(joined.lines[0].last_beam, 92);
   EXPECT_NEAR(joined.lines[0].rho_m, 3.0, 1e-9);
   EXPECT_NEAR(joined.lines[0].alpha_rad, 0.0, 1e-9);
+}
+
+TEST(ExtractFeaturesTest, IsolatedDropoutsDoNotBreakWalls) {
+  // The room with every 7th beam a no-return (lost echo), pairs included.
+  Rng rng(6);
+  BeamNoise noise;
+  noise.range_std_m = 0.005;
+  SyntheticScan cast = CastScan(Polygon(kRoomCorners), kRoomSensor, noise, &rng);
+  for (int i = 3; i < cast.scan.size(); i += 7) {
+    for (int j = i; j <= std::min(i + (i % 2), cast.scan.size() - 1); ++j) {
+      cast.scan.ranges_m[j] = cast.scan.max_range_m;
+      cast.scan.has_return[j] = 0;
+    }
+  }
+  const ScanFeatures features = ExtractFeatures(cast.scan, FeatureExtractionParams());
+  EXPECT_EQ(features.lines.size(), 3u);
+  ASSERT_EQ(features.corners.size(), 2u);
+  EXPECT_EQ(features.corners[0].kind, CornerKind::kConcave);
+  EXPECT_EQ(features.corners[1].kind, CornerKind::kConcave);
+  // Control: without bridging, every dropout ends a cluster.
+  FeatureExtractionParams no_bridging;
+  no_bridging.max_missing_beams = 0;
+  EXPECT_GT(ExtractFeatures(cast.scan, no_bridging).lines.size(), 6u);
 }
 
 TEST(ExtractFeaturesTest, RespectsMinPointsAndMinLength) {
@@ -547,8 +640,8 @@ TEST(ExtractFeaturesTest, LineCovarianceIsConsistentInARoom) {
 }
 
 // With the default model-error floor the covariance is a little conservative,
-// never over-confident: the mean NIS stays below the upper bound of the honest
-// test and above 1.
+// never over-confident, and only a little: the mean NIS stays below the upper
+// bound of the honest test and above 1.5 (the honest value is 2).
 TEST(ExtractFeaturesTest, DefaultFloorIsSmallAndConservative) {
   const std::uint64_t seed = 20240603;
   BeamNoise noise;
@@ -560,7 +653,7 @@ TEST(ExtractFeaturesTest, DefaultFloorIsSmallAndConservative) {
   std::printf("seed %llu: %zu lines, mean NIS %.3f (honest bounds [%.3f, %.3f])\n",
               static_cast<unsigned long long>(seed), nis.size(), mean, bounds.low, bounds.high);
   EXPECT_LT(mean, bounds.high);
-  EXPECT_GT(mean, 1.0);
+  EXPECT_GT(mean, 1.5);
 }
 
 // ---------------------------------------------------------------------------
@@ -681,6 +774,138 @@ TEST(ExtractFeaturesTest, NoCornerAtOcclusionEdge) {
     EXPECT_EQ(corner.kind, CornerKind::kConvex);
     EXPECT_LT((corner.p_SC - box[3]).norm(), 0.03) << "scan " << k;
   }
+}
+
+// A box whose face ends 15 cm in front of a wall: the range jump at the
+// face's end is below the breakpoint distance, so the face and the wall behind
+// it fall in one cluster, and their lines meet within the endpoint tolerance
+// of both segment ends. But the wall's seen segment runs past that
+// intersection (the wall continues behind the box), so it is no vertex.
+TEST(ExtractFeaturesTest, NoCornerWhereAWallContinuesBehindANearbyBox) {
+  std::vector<Wall> walls = {{{4.0, -20.0}, {4.0, 20.0}}};
+  const Eigen::Vector2d along(std::sqrt(0.5), std::sqrt(0.5));
+  const Eigen::Vector2d inward(std::sqrt(0.5), -std::sqrt(0.5));
+  const Eigen::Vector2d vertex(3.85, 0.02);
+  const std::vector<Eigen::Vector2d> box = {vertex, vertex - along,
+                                            vertex - along + 0.1 * inward,
+                                            vertex + 0.1 * inward};
+  for (const Wall& wall : Polygon(box)) walls.push_back(wall);
+  BeamNoise noise;
+  noise.range_std_m = 0.005;
+  const Rng root(20240608);
+  int near_both_ends = 0;
+  for (int k = 0; k < 50; ++k) {
+    Rng rng = root.Fork("scan" + std::to_string(k));
+    const SyntheticScan cast = CastScan(walls, Pose2(), noise, &rng);
+    const ScanFeatures features = ExtractFeatures(cast.scan, FeatureExtractionParams());
+    EXPECT_TRUE(features.corners.empty()) << "scan " << k;
+    // Control: the face and the wall beyond it are neighbouring lines in the
+    // scan, at 45 degrees, and (in most scans) both seen segments end within
+    // 0.25 m of their intersection, inside the endpoint tolerance.
+    ASSERT_EQ(features.lines.size(), 3u) << "scan " << k;
+    const LineObservation& face = features.lines[1];
+    const LineObservation& wall = features.lines[2];
+    ASSERT_EQ(WallOfLine(face, cast.hit_wall), 1) << "scan " << k;
+    ASSERT_EQ(WallOfLine(wall, cast.hit_wall), 0) << "scan " << k;
+    ASSERT_LE(wall.first_beam - face.last_beam, 3) << "scan " << k;
+    const Eigen::Vector2d meet =
+        IntersectLines({face.rho_m, face.alpha_rad}, {wall.rho_m, wall.alpha_rad});
+    if ((face.p_SB - meet).norm() < 0.25 && (wall.p_SA - meet).norm() < 0.25) ++near_both_ends;
+  }
+  EXPECT_GE(near_both_ends, 40);
+}
+
+// Random rectangular rooms, each with a turned box inside, seen from random
+// poses (300 scenes, seed printed): every reported corner lies within 5 cm of
+// a true vertex of the right kind (room vertices concave, box vertices
+// convex), so no corner comes from an occlusion edge; every line's NIS against
+// its wall is below 30 (chi-square(2) exceeds it with probability 3e-7); no
+// two lines share a beam; and most corners are found.
+TEST(ExtractFeaturesTest, NoSpuriousFeaturesInRandomRoomsWithBoxes) {
+  const std::uint64_t seed = 20240607;
+  const Rng root(seed);
+  BeamNoise noise;
+  noise.range_std_m = 0.005;
+  int lines = 0;
+  int corners = 0;
+  int convex = 0;
+  double worst_nis = 0.0;
+  for (int k = 0; k < 300; ++k) {
+    Rng rng = root.Fork("scene" + std::to_string(k));
+    // The room and the box, in W.
+    const double width = 3.0 + 6.0 * rng.Uniform();
+    const double height = 3.0 + 6.0 * rng.Uniform();
+    const std::vector<Eigen::Vector2d> room = {
+        {0.0, 0.0}, {width, 0.0}, {width, height}, {0.0, height}};
+    const Eigen::Vector2d centre(1.0 + (width - 2.0) * rng.Uniform(),
+                                 1.0 + (height - 2.0) * rng.Uniform());
+    const double box_width = 0.3 + 0.7 * rng.Uniform();
+    const double box_depth = 0.3 + 0.7 * rng.Uniform();
+    const double box_angle = kPi * rng.Uniform();
+    const Eigen::Vector2d u(std::cos(box_angle), std::sin(box_angle));
+    const Eigen::Vector2d v(-u.y(), u.x());
+    const std::vector<Eigen::Vector2d> box = {
+        centre - 0.5 * box_width * u - 0.5 * box_depth * v,
+        centre + 0.5 * box_width * u - 0.5 * box_depth * v,
+        centre + 0.5 * box_width * u + 0.5 * box_depth * v,
+        centre - 0.5 * box_width * u + 0.5 * box_depth * v};
+    std::vector<Wall> walls = Polygon(room);
+    for (const Wall& wall : Polygon(box)) walls.push_back(wall);
+    // A sensor pose in the room, at least 0.3 m from the walls and the box.
+    Pose2 X_WS;
+    for (int attempt = 0; attempt < 1000; ++attempt) {
+      X_WS = Pose2(0.3 + (width - 0.6) * rng.Uniform(), 0.3 + (height - 0.6) * rng.Uniform(),
+                   kPi * (2.0 * rng.Uniform() - 1.0));
+      const Eigen::Vector2d offset = X_WS.translation() - centre;
+      if (std::abs(offset.dot(u)) > 0.5 * box_width + 0.3 ||
+          std::abs(offset.dot(v)) > 0.5 * box_depth + 0.3) {
+        break;
+      }
+    }
+    const SyntheticScan cast = CastScan(walls, X_WS, noise, &rng);
+    const ScanFeatures features = ExtractFeatures(cast.scan, FeatureExtractionParams());
+    const Pose2 X_SW = X_WS.Inverse();
+    for (const CornerObservation& corner : features.corners) {
+      ++corners;
+      convex += corner.kind == CornerKind::kConvex ? 1 : 0;
+      double nearest = std::numeric_limits<double>::infinity();
+      bool nearest_is_box = false;
+      for (int i = 0; i < 4; ++i) {
+        const double to_room = (X_SW * room[i] - corner.p_SC).norm();
+        const double to_box = (X_SW * box[i] - corner.p_SC).norm();
+        if (to_room < nearest) {
+          nearest = to_room;
+          nearest_is_box = false;
+        }
+        if (to_box < nearest) {
+          nearest = to_box;
+          nearest_is_box = true;
+        }
+      }
+      EXPECT_LT(nearest, 0.05) << "scene " << k;
+      EXPECT_EQ(corner.kind, nearest_is_box ? CornerKind::kConvex : CornerKind::kConcave)
+          << "scene " << k;
+    }
+    for (std::size_t i = 1; i < features.lines.size(); ++i) {
+      EXPECT_LT(features.lines[i - 1].last_beam, features.lines[i].first_beam)
+          << "scene " << k << ": lines share beams";
+    }
+    for (const LineObservation& line : features.lines) {
+      ++lines;
+      const int wall = WallOfLine(line, cast.hit_wall);
+      ASSERT_GE(wall, 0);
+      const double nis = Nis({line.rho_m, line.alpha_rad}, TrueLineInSensor(walls[wall], X_WS),
+                             line.covariance);
+      worst_nis = std::max(worst_nis, nis);
+      EXPECT_LT(nis, 30.0) << "scene " << k << " beams " << line.first_beam << "-"
+                           << line.last_beam;
+    }
+  }
+  std::printf("seed %llu: %d lines (worst NIS %.1f), %d corners (%d convex)\n",
+              static_cast<unsigned long long>(seed), lines, worst_nis, corners, convex);
+  // About 1.5 corners a scene in this setting; far fewer means they are missed.
+  EXPECT_GT(corners, 300);
+  EXPECT_GT(convex, 20);
 }
 
 }  // namespace

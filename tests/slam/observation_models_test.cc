@@ -4,11 +4,13 @@
 #include "slam/observation_models.h"
 
 #include <cmath>
+#include <vector>
 
 #include <gtest/gtest.h>
 
 #include "common/angles.h"
 #include "common/rng.h"
+#include "slam/fast_wrap.h"
 #include "slam/motion_model.h"
 #include "tests/slam/ekf_test_utils.h"
 
@@ -44,6 +46,23 @@ Eigen::Vector2d LineInSensorByGeometry(const Pose2& X_WS, const Eigen::Vector2d&
     alpha += kPi;
   }
   return {rho, WrapAngle(alpha)};
+}
+
+TEST(FastWrapTest, EqualsWrapAngleExactly) {
+  Rng rng(10);
+  std::vector<double> angles = {0.0, -0.0, kPi, -kPi, 2.0 * kPi, -2.0 * kPi, 3.0 * kPi,
+                                -3.0 * kPi, std::nextafter(kPi, 10.0), std::nextafter(-kPi, -10.0),
+                                std::nextafter(3.0 * kPi, 0.0), std::nextafter(-3.0 * kPi, 0.0),
+                                1e6, -1e6, 100.0 * kPi + 0.5};
+  for (int i = 0; i < 100000; ++i) angles.push_back(20.0 * (2.0 * rng.Uniform() - 1.0));
+  for (int i = 0; i < 1000; ++i) angles.push_back(kPi * (1.0 + 1e-12 * rng.Gaussian(0.0, 1.0)));
+  for (const double angle : angles) {
+    const double fast = WrapAngleFast(angle);
+    const double reference = WrapAngle(angle);
+    // Exactly equal (only the sign of a zero result may differ).
+    ASSERT_EQ(fast, reference) << "angle " << angle;
+  }
+  EXPECT_TRUE(std::isnan(WrapAngleFast(NAN)));
 }
 
 TEST(ObservationModelsTest, SensorPoseComposesMountAndJacobianMatches) {

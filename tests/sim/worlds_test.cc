@@ -1,0 +1,147 @@
+// Every shipped world (worlds/*.xml, found at run time, so new worlds are
+// covered): it loads with the robot, its start pose is collision-free, its
+// obstacles stand on the floor and reach above the laser, its tour keeps
+// clear of the walls, and the robot can drive the whole tour with a simple
+// point-h controller without touching anything.
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "common/angles.h"
+#include "sim/obstacles.h"
+#include "sim/simulator.h"
+#include "tests/sim/sim_test_util.h"
+
+namespace mjslam::sim {
+namespace {
+
+using testing::MujocoTest;
+using testing::RobotModelPath;
+
+std::vector<std::string> ShippedWorlds() {
+  std::vector<std::string> worlds;
+  for (const auto& entry :
+       std::filesystem::directory_iterator(std::string(MJSLAM_SOURCE_DIR) + "/worlds")) {
+    if (entry.path().extension() == ".xml") worlds.push_back(entry.path().string());
+  }
+  std::sort(worlds.begin(), worlds.end());
+  return worlds;
+}
+
+std::string BaseName(const std::string& path) {
+  return std::filesystem::path(path).filename().string();
+}
+
+class WorldsTest : public MujocoTest {};
+
+TEST_F(WorldsTest, TheRequiredWorldsAreShipped) {
+  std::vector<std::string> names;
+  for (const std::string& world : ShippedWorlds()) names.push_back(BaseName(world));
+  for (const char* required : {"room.xml", "corridor_loop.xml", "office.xml", "pillars.xml"}) {
+    EXPECT_NE(std::find(names.begin(), names.end(), required), names.end()) << required;
+  }
+}
+
+TEST_F(WorldsTest, EveryWorldLoadsWithAFreeStartAndAClearTour) {
+  for (const std::string& world : ShippedWorlds()) {
+    SCOPED_TRACE(world);
+    Simulator sim(world, RobotModelPath(), SimParams{}, RobotParams{});
+    EXPECT_EQ(sim.CountRobotWorldContacts(), 0);
+    const Pose2 start = sim.StartPose();
+    EXPECT_NEAR(sim.X_WR().x, start.x, 1e-3);
+    EXPECT_NEAR(sim.X_WR().y, start.y, 1e-3);
+
+    // Obstacles: exact shapes, on the floor, taller than the laser.
+    const std::vector<ObstacleFootprint> obstacles = sim.Obstacles();
+    ASSERT_FALSE(obstacles.empty());
+    for (const ObstacleFootprint& obstacle : obstacles) {
+      EXPECT_TRUE(obstacle.exact) << obstacle.name;
+      EXPECT_LE(obstacle.z_min_m, 0.01) << obstacle.name;
+      EXPECT_GE(obstacle.z_max_m, 0.9) << obstacle.name;
+    }
+
+    // Tour: at least 3 waypoints, each >= 0.5 m from every obstacle, and so
+    // is every point of the closed polyline between them.
+    const std::vector<Eigen::Vector2d> tour = sim.TourWaypoints();
+    ASSERT_GE(tour.size(), 3u);
+    double closest = 1e9;
+    for (std::size_t i = 0; i < tour.size(); ++i) {
+      EXPECT_GE(DistanceToObstacles(tour[i], obstacles), 0.5) << "tour_" << i;
+      const Eigen::Vector2d& a = tour[i];
+      const Eigen::Vector2d& b = tour[(i + 1) % tour.size()];
+      for (int k = 0; k <= 100; ++k) {
+        const Eigen::Vector2d p = a + (b - a) * (k / 100.0);
+        closest = std::min(closest, DistanceToObstacles(p, obstacles));
+      }
+    }
+    EXPECT_GE(closest, 0.5);
+    std::cout << BaseName(world) << ": " << obstacles.size() << " obstacles, " << tour.size()
+              << " waypoints, closest approach of the tour " << closest << " m\n";
+
+    // The laser sees walls from the start, and never closer than the
+    // geometry allows (the laser is behind h, inside the free space).
+    const LaserScan scan = sim.CastLaser(LaserParams{});
+    int returns = 0;
+    for (int i = 0; i < scan.size(); ++i) returns += scan.has_return[i];
+    EXPECT_GT(returns, 0);
+  }
+}
+
+// Drives the tour once with a proportional controller on the point h (the
+// offset a makes its kinematics invertible, Eq. (6)), checking for contacts
+// every 0.1 s. Returns the distance driven by h.
+double DriveTour(Simulator* sim, double speed_mps) {
+  const std::vector<Eigen::Vector2d> tour = sim->TourWaypoints();
+  const double a = sim->robot().control_point_offset_m;
+  std::size_t target = 1;
+  std::size_t reached = 0;
+  double driven = 0.0;
+  Eigen::Vector2d last = sim->X_WR().translation();
+  double last_progress_s = 0.0;
+  while (reached < tour.size()) {
+    const Pose2 X_WR = sim->X_WR();
+    const Eigen::Vector2d error = tour[target % tour.size()] - X_WR.translation();
+    if (error.norm() < 0.25) {
+      ++reached;
+      ++target;
+      last_progress_s = sim->time_s();
+      continue;
+    }
+    // Desired velocity of h, then (v, w) from the inverse of Eq. (6).
+    const Eigen::Vector2d velocity = error.normalized() * std::min(speed_mps, 1.5 * error.norm());
+    const double c = std::cos(X_WR.theta);
+    const double s = std::sin(X_WR.theta);
+    sim->SetCommand(
+        {c * velocity.x() + s * velocity.y(), (-s * velocity.x() + c * velocity.y()) / a});
+    sim->Advance(0.1);
+    driven += (sim->X_WR().translation() - last).norm();
+    last = sim->X_WR().translation();
+    EXPECT_EQ(sim->CountRobotWorldContacts(), 0)
+        << "contact at t = " << sim->time_s() << " s near tour_" << target % tour.size();
+    if (sim->CountRobotWorldContacts() > 0 || sim->time_s() - last_progress_s > 60.0) {
+      ADD_FAILURE() << "stuck before tour_" << target % tour.size();
+      break;
+    }
+  }
+  return driven;
+}
+
+TEST_F(WorldsTest, TheRobotDrivesEveryTourWithoutTouchingAnything) {
+  for (const std::string& world : ShippedWorlds()) {
+    SCOPED_TRACE(world);
+    Simulator sim(world, RobotModelPath(), SimParams{}, RobotParams{});
+    const double driven = DriveTour(&sim, 0.5);
+    std::cout << BaseName(world) << ": drove the tour, " << driven << " m in " << sim.time_s()
+              << " s\n";
+    EXPECT_GT(driven, 5.0);
+  }
+}
+
+}  // namespace
+}  // namespace mjslam::sim

@@ -1,0 +1,355 @@
+// EkfSlam end to end on hand-made scans: parameters, bad input, prediction
+// from commands and odometry, data association (gate, same type, nearest
+// neighbour, duplicate guard), both correction modes and the secondary map.
+
+#include "slam/ekf_slam.h"
+
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include <Eigen/LU>
+#include <gtest/gtest.h>
+
+#include "common/angles.h"
+#include "common/params.h"
+#include "slam/data_association.h"
+#include "slam/slam_params.h"
+
+namespace mjslam::slam {
+namespace {
+
+constexpr double kRhoStd = 0.01;
+constexpr double kAlphaStd = 0.002;
+
+LineObservation Line(double rho, double alpha, const Eigen::Vector2d& p_SA,
+                     const Eigen::Vector2d& p_SB) {
+  LineObservation line;
+  line.rho_m = rho;
+  line.alpha_rad = alpha;
+  line.covariance = Eigen::Vector2d(kRhoStd * kRhoStd, kAlphaStd * kAlphaStd).asDiagonal();
+  line.p_SA = p_SA;
+  line.p_SB = p_SB;
+  return line;
+}
+
+// The wall x = 2 seen from the origin facing +x, from y = y0 to y = y1.
+LineObservation WallAtTwo(double rho_offset, double y0 = -1.0, double y1 = 1.0) {
+  return Line(2.0 + rho_offset, 0.0, Eigen::Vector2d(2.0, y0), Eigen::Vector2d(2.0, y1));
+}
+
+CornerObservation Corner(double range, double bearing) {
+  CornerObservation corner;
+  corner.range_m = range;
+  corner.bearing_rad = bearing;
+  corner.covariance = Eigen::Vector2d(0.02 * 0.02, 0.005 * 0.005).asDiagonal();
+  corner.p_SC = range * Eigen::Vector2d(std::cos(bearing), std::sin(bearing));
+  return corner;
+}
+
+// A record with no motion (dt = 0), so that the map and pose covariance do
+// not change between scans.
+SensorRecord Still() { return SensorRecord{}; }
+
+TEST(EkfParamsTest, DefaultsAreValidAndBadValuesAreNamed) {
+  EXPECT_TRUE(EkfParams().Validate().empty());
+  EkfParams params;
+  params.input = "wheels";
+  params.control_point_offset_m = 0.0;
+  params.gate_probability = 1.0;
+  params.new_feature_probability = 0.5;
+  params.max_updates = 0;
+  params.command_noise.v_noise_fraction = -1.0;
+  const std::vector<ParamProblem> problems = params.Validate();
+  std::string keys;
+  for (const ParamProblem& problem : problems) keys += problem.key + " ";
+  EXPECT_NE(keys.find("input"), std::string::npos) << keys;
+  EXPECT_NE(keys.find("control_point_offset_m"), std::string::npos) << keys;
+  EXPECT_NE(keys.find("gate_probability"), std::string::npos) << keys;
+  EXPECT_NE(keys.find("new_feature_probability"), std::string::npos) << keys;
+  EXPECT_NE(keys.find("max_updates"), std::string::npos) << keys;
+  EXPECT_NE(keys.find("command_noise.v_noise_fraction"), std::string::npos) << keys;
+  EXPECT_THROW(params.ValidateOrThrow(), ParamError);
+}
+
+TEST(SlamParamsTest, MergesBothPartsWithPrefixes) {
+  SlamParams params;
+  EXPECT_TRUE(params.Validate().empty());
+  params.ekf.max_updates = 0;
+  params.features.min_points = 1;
+  std::string keys;
+  for (const ParamProblem& problem : params.Validate()) keys += problem.key + " ";
+  EXPECT_NE(keys.find("ekf.max_updates"), std::string::npos) << keys;
+  EXPECT_NE(keys.find("features.min_points"), std::string::npos) << keys;
+  EXPECT_THROW(params.ValidateOrThrow(), ParamError);
+}
+
+TEST(EkfSlamTest, ConstructorRejectsInvalidParams) {
+  EkfParams params;
+  params.input = "wheels";
+  try {
+    EkfSlam filter(params, CorrectionMode::kClassical, Pose2(), Pose2());
+    FAIL() << "no exception";
+  } catch (const ParamError& error) {
+    EXPECT_NE(std::string(error.what()).find("slam.ekf: input"), std::string::npos)
+        << error.what();
+    EXPECT_NE(std::string(error.what()).find("wheels"), std::string::npos) << error.what();
+  }
+  EXPECT_THROW(EkfSlam(EkfParams(), CorrectionMode::kClassical, Pose2(NAN, 0, 0), Pose2()),
+               SlamInputError);
+}
+
+TEST(EkfSlamTest, RejectsBadInputAndStaysUnchanged) {
+  EkfSlam filter(EkfParams(), CorrectionMode::kClassical, Pose2(), Pose2());
+  ScanFeatures features;
+  features.lines.push_back(WallAtTwo(0.0));
+  filter.Step(Still(), &features);
+  const Eigen::VectorXd state = filter.state();
+
+  SensorRecord negative_dt;
+  negative_dt.dt_s = -0.1;
+  EXPECT_THROW(filter.Step(negative_dt, nullptr), SlamInputError);
+
+  SensorRecord moving;
+  moving.dt_s = 0.1;
+  moving.command = Twist2{0.5, 0.0};
+  ScanFeatures bad = features;
+  bad.lines[0].covariance(0, 0) = NAN;
+  EXPECT_THROW(filter.Step(moving, &bad), SlamInputError);
+  bad = features;
+  bad.lines[0].covariance = Eigen::Matrix2d::Zero();
+  EXPECT_THROW(filter.Step(moving, &bad), SlamInputError);
+  ScanFeatures bad_corner;
+  bad_corner.corners.push_back(Corner(-1.0, 0.0));
+  EXPECT_THROW(filter.Step(moving, &bad_corner), SlamInputError);
+
+  // Nothing changed, not even the prediction.
+  EXPECT_TRUE((filter.state().array() == state.array()).all());
+}
+
+TEST(EkfSlamTest, PredictsFromCommands) {
+  EkfParams params;
+  params.control_point_offset_m = 0.2;
+  EkfSlam filter(params, CorrectionMode::kClassical, Pose2(1.0, 2.0, kPi / 2.0), Pose2());
+  SensorRecord record;
+  record.dt_s = 0.1;
+  record.command = Twist2{0.5, 0.0};
+  for (int i = 0; i < 10; ++i) {
+    const StepReport report = filter.Step(record, nullptr);
+    EXPECT_EQ(report.num_observed, 0);
+    EXPECT_EQ(report.num_updated, 0);
+  }
+  EXPECT_NEAR(filter.X_WR().x, 1.0, 1e-12);
+  EXPECT_NEAR(filter.X_WR().y, 2.5, 1e-12);
+  // The covariance grew from zero along the motion: sigma_v dt per step.
+  const double sigma_v = params.command_noise.v_noise_std_mps +
+                         params.command_noise.v_noise_fraction * 0.5;
+  EXPECT_NEAR(filter.pose_covariance()(1, 1), 10 * 0.01 * sigma_v * sigma_v, 1e-12);
+  EXPECT_GT(filter.pose_covariance()(0, 0), 0.0);
+}
+
+TEST(EkfSlamTest, PredictsFromOdometry) {
+  // Odometry generated with Eq. (6)'s own kinematics, (d, a dth, dth) per
+  // record in the previous R frame: the filter must reproduce it exactly.
+  EkfParams params;
+  params.input = "odometry";
+  params.control_point_offset_m = 0.15;
+  const Pose2 X_WR0(3.0, -1.0, 0.4);
+  EkfSlam filter(params, CorrectionMode::kSelective, X_WR0, Pose2());
+  Pose2 X_OR;
+  SensorRecord record;
+  for (int i = 0; i < 50; ++i) {
+    const double d = 0.05;
+    const double dth = 0.04 * std::sin(0.1 * i);
+    X_OR = X_OR * Pose2(d, params.control_point_offset_m * dth, dth);
+    record.dt_s = i == 0 ? 0.0 : 0.1;
+    record.X_OR = X_OR;
+    record.command = Twist2{100.0, 100.0};  // ignored
+    filter.Step(record, nullptr);
+  }
+  const Pose2 expected = X_WR0 * X_OR;
+  EXPECT_NEAR(filter.X_WR().x, expected.x, 1e-9);
+  EXPECT_NEAR(filter.X_WR().y, expected.y, 1e-9);
+  EXPECT_NEAR(WrapAngle(filter.X_WR().theta - expected.theta), 0.0, 1e-9);
+  EXPECT_GT(filter.pose_covariance().determinant(), 0.0);
+}
+
+TEST(EkfSlamTest, FirstScanAddsFeaturesAndTheSecondMatchesThem) {
+  for (const CorrectionMode mode : {CorrectionMode::kClassical, CorrectionMode::kSelective}) {
+    EkfSlam filter(EkfParams(), mode, Pose2(), Pose2(0.1, 0.0, 0.0));
+    ScanFeatures features;
+    features.lines.push_back(Line(2.0, 0.0, {2.0, -1.0}, {2.0, 1.0}));
+    features.lines.push_back(Line(1.5, kPi / 2.0, {-1.0, 1.5}, {1.0, 1.5}));
+    features.lines.push_back(Line(1.0, -kPi / 2.0, {-1.0, -1.0}, {1.0, -1.0}));
+    features.corners.push_back(Corner(2.5, 0.6));
+    StepReport report = filter.Step(Still(), &features);
+    EXPECT_EQ(report.num_observed, 4);
+    EXPECT_EQ(report.num_new, 4);
+    EXPECT_EQ(report.num_matched, 0);
+    EXPECT_EQ(report.num_features, 4);
+
+    report = filter.Step(Still(), &features);
+    EXPECT_EQ(report.num_matched, 4);
+    EXPECT_EQ(report.num_new, 0);
+    EXPECT_EQ(report.num_features, 4);
+    EXPECT_EQ(report.num_updated, mode == CorrectionMode::kClassical ? 4 : 2);
+  }
+}
+
+TEST(EkfSlamTest, GatesByMahalanobisDistanceWithADuplicateGuard) {
+  // Known pose, no motion: S_rho = 2 kRhoStd^2 for the second look at the
+  // wall, so d2 = (offset / kRhoStd)^2 / 2. Gate 9.21 (99 %), new-feature
+  // threshold 18.4 (99.99 %).
+  struct Case {
+    double offset_sigmas;
+    int matched;
+    int ambiguous;
+    int added;
+  };
+  for (const Case& c : {Case{4.0, 1, 0, 0}, Case{5.0, 0, 1, 0}, Case{7.0, 0, 0, 1}}) {
+    EkfSlam filter(EkfParams(), CorrectionMode::kClassical, Pose2(), Pose2());
+    ScanFeatures first;
+    first.lines.push_back(WallAtTwo(0.0));
+    filter.Step(Still(), &first);
+    ScanFeatures second;
+    second.lines.push_back(WallAtTwo(c.offset_sigmas * kRhoStd));
+    const StepReport report = filter.Step(Still(), &second);
+    EXPECT_EQ(report.num_matched, c.matched) << c.offset_sigmas << " sigma";
+    EXPECT_EQ(report.num_ambiguous, c.ambiguous) << c.offset_sigmas << " sigma";
+    EXPECT_EQ(report.num_new, c.added) << c.offset_sigmas << " sigma";
+    EXPECT_EQ(filter.num_features(), 1 + c.added);
+  }
+  // A stricter gate rejects the 4-sigma one too.
+  EkfParams strict;
+  strict.gate_probability = 0.95;  // 5.99 < 8
+  EkfSlam filter(strict, CorrectionMode::kClassical, Pose2(), Pose2());
+  ScanFeatures first;
+  first.lines.push_back(WallAtTwo(0.0));
+  filter.Step(Still(), &first);
+  ScanFeatures second;
+  second.lines.push_back(WallAtTwo(4.0 * kRhoStd));
+  EXPECT_EQ(filter.Step(Still(), &second).num_matched, 0);
+}
+
+TEST(EkfSlamTest, MatchesOnlyFeaturesOfTheSameType) {
+  // A corner observation with the very numbers of the line's prediction.
+  EkfSlam filter(EkfParams(), CorrectionMode::kClassical, Pose2(), Pose2());
+  ScanFeatures first;
+  first.lines.push_back(WallAtTwo(0.0));
+  filter.Step(Still(), &first);
+  ScanFeatures second;
+  second.corners.push_back(Corner(2.0, 0.0));
+  const StepReport report = filter.Step(Still(), &second);
+  EXPECT_EQ(report.num_matched, 0);
+  EXPECT_EQ(report.num_new, 1);
+  EXPECT_EQ(filter.Map().back().type, MapFeature::Type::kCorner);
+  // And a corner matches a corner.
+  const StepReport again = filter.Step(Still(), &second);
+  EXPECT_EQ(again.num_matched, 1);
+  EXPECT_EQ(again.num_new, 0);
+}
+
+TEST(EkfSlamTest, NearestNeighbourTakesEachFeatureOnce) {
+  EkfSlam filter(EkfParams(), CorrectionMode::kClassical, Pose2(), Pose2());
+  ScanFeatures first;
+  first.lines.push_back(WallAtTwo(0.0));
+  filter.Step(Still(), &first);
+  // Two observations inside the gate of the one wall: the nearer one (listed
+  // second) wins, the other is neither matched nor added.
+  ScanFeatures second;
+  second.lines.push_back(WallAtTwo(2.0 * kRhoStd));
+  second.lines.push_back(WallAtTwo(-1.0 * kRhoStd));
+  const StepReport report = filter.Step(Still(), &second);
+  EXPECT_EQ(report.num_matched, 1);
+  EXPECT_EQ(report.num_ambiguous, 1);
+  EXPECT_EQ(report.num_new, 0);
+  // The estimate moved towards the nearer observation (-1 sigma), not the other.
+  EXPECT_LT(filter.Map()[0].params.x(), 2.0);
+}
+
+TEST(DataAssociationTest, ChiSquareQuantilesOfTwoDof) {
+  EXPECT_NEAR(ChiSquare2Quantile(0.95), 5.991, 1e-3);
+  EXPECT_NEAR(ChiSquare2Quantile(0.99), 9.210, 1e-3);
+  EXPECT_NEAR(ChiSquare2Quantile(0.9999), 18.421, 1e-3);
+}
+
+TEST(DataAssociationTest, GreedyNearestNeighbourWithUniquenessAndGuard) {
+  const double inf = std::numeric_limits<double>::infinity();
+  // Rows: observations; columns: features. Observation 1 is nearest to
+  // feature 0 (0.5) and takes it; observation 0 then falls back to its next
+  // feature inside the gate, 1 (5.0), which observation 1 no longer needs.
+  Eigen::MatrixXd d2(5, 3);
+  d2 << 1.0, 5.0, inf,
+        0.5, 3.0, inf,
+        inf, inf, 12.0,   // between gate and new threshold: ambiguous
+        inf, inf, 30.0,   // far from everything: new
+        NAN, 20.0, 19.0;  // NaN ignored, the rest beyond the threshold: new
+  const Association association = AssociateNearestNeighbour(d2, 9.21, 18.42);
+  EXPECT_EQ(association.feature[1], 0);
+  EXPECT_EQ(association.outcome[1], AssociationOutcome::kMatched);
+  EXPECT_EQ(association.feature[0], 1);
+  EXPECT_EQ(association.outcome[0], AssociationOutcome::kMatched);
+  EXPECT_EQ(association.outcome[2], AssociationOutcome::kAmbiguous);
+  EXPECT_EQ(association.feature[2], -1);
+  EXPECT_EQ(association.outcome[3], AssociationOutcome::kNew);
+  EXPECT_EQ(association.outcome[4], AssociationOutcome::kNew);
+
+  // A lost contest inside the gate is ambiguous, not new.
+  Eigen::MatrixXd contest(2, 1);
+  contest << 2.0, 1.0;
+  const Association lost = AssociateNearestNeighbour(contest, 9.21, 18.42);
+  EXPECT_EQ(lost.outcome[1], AssociationOutcome::kMatched);
+  EXPECT_EQ(lost.outcome[0], AssociationOutcome::kAmbiguous);
+}
+
+TEST(EkfSlamTest, SecondaryMapExtendsAndFollowsTheLine) {
+  EkfSlam filter(EkfParams(), CorrectionMode::kClassical, Pose2(), Pose2());
+  ScanFeatures first;
+  first.lines.push_back(WallAtTwo(0.0, -1.0, 1.0));
+  filter.Step(Still(), &first);
+  MapFeature wall = filter.Map()[0];
+  ASSERT_TRUE(wall.has_segment);
+  EXPECT_NEAR((wall.p_WA - Eigen::Vector2d(2.0, -1.0)).norm(), 0.0, 1e-9);
+  EXPECT_NEAR((wall.p_WB - Eigen::Vector2d(2.0, 1.0)).norm(), 0.0, 1e-9);
+
+  // More of the wall seen, slightly off the line: the segment grows to
+  // y = 3 and stays on the corrected line estimate.
+  ScanFeatures second;
+  second.lines.push_back(Line(2.0 + 0.5 * kRhoStd, 0.001, {2.0, 0.0}, {2.0, 3.0}));
+  EXPECT_EQ(filter.Step(Still(), &second).num_matched, 1);
+  wall = filter.Map()[0];
+  const Eigen::Vector2d normal(std::cos(wall.params.y()), std::sin(wall.params.y()));
+  EXPECT_NEAR(normal.dot(wall.p_WA), wall.params.x(), 1e-12);
+  EXPECT_NEAR(normal.dot(wall.p_WB), wall.params.x(), 1e-12);
+  EXPECT_NEAR(wall.p_WA.y(), -1.0, 0.02);
+  EXPECT_NEAR(wall.p_WB.y(), 3.0, 0.02);
+  EXPECT_NE(wall.params.x(), 2.0);  // the line was corrected
+
+  // A shorter look does not shrink it.
+  ScanFeatures third;
+  third.lines.push_back(WallAtTwo(0.0, 0.5, 1.0));
+  filter.Step(Still(), &third);
+  EXPECT_NEAR(filter.Map()[0].p_WA.y(), -1.0, 0.02);
+  EXPECT_NEAR(filter.Map()[0].p_WB.y(), 3.0, 0.02);
+}
+
+TEST(EkfSlamTest, MapIsCanonicalWithStableIds) {
+  // From (3, 0) facing -x the wall x = 1 is seen as rho = 2, alpha = 0; the
+  // inverse model gives r = 2 + 3 cos(pi) = -1 at al = pi, canonical (1, 0).
+  EkfSlam filter(EkfParams(), CorrectionMode::kClassical, Pose2(3.0, 0.0, kPi), Pose2());
+  ScanFeatures features;
+  features.lines.push_back(Line(2.0, 0.0, {2.0, 1.0}, {2.0, -1.0}));
+  features.corners.push_back(Corner(1.0, 0.3));
+  filter.Step(Still(), &features);
+  const std::vector<MapFeature> map = filter.Map();
+  ASSERT_EQ(map.size(), 2u);
+  EXPECT_EQ(map[0].id, 0);
+  EXPECT_EQ(map[1].id, 1);
+  EXPECT_NEAR(map[0].params.x(), 1.0, 1e-12);
+  EXPECT_NEAR(map[0].params.y(), 0.0, 1e-12);
+  EXPECT_FALSE(map[1].has_segment);
+  EXPECT_GT(map[0].covariance.determinant(), 0.0);
+}
+
+}  // namespace
+}  // namespace mjslam::slam
