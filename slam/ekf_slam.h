@@ -43,17 +43,20 @@ struct StepReport {
 
 /// A map feature as the filter estimates it, for maps and metrics.
 struct MapFeature {
+  /// The feature kinds: Type::kLine, Type::kCorner.
   using Type = FeatureType;
   /// Stable id, in order of creation from 0.
   int id = 0;
+  /// Line or corner.
   Type type = Type::kLine;
   /// (r, al) in W in canonical form (r >= 0, al in (-pi, pi]) for a line;
   /// (x, y) of the corner in W. Metres, radians.
   Eigen::Vector2d params = Eigen::Vector2d::Zero();
   /// Marginal covariance of `params` (the 2x2 block of P).
   Eigen::Matrix2d covariance = Eigen::Matrix2d::Zero();
-  /// True for lines: the secondary map's seen segment from p_WA to p_WB, on
-  /// the current line estimate. False (and zero points) for corners.
+  /// True for lines: the secondary map's seen segment from p_WA to p_WB
+  /// (metres, in W), on the current line estimate. False (and zero points)
+  /// for corners.
   bool has_segment = false;
   Eigen::Vector2d p_WA = Eigen::Vector2d::Zero();
   Eigen::Vector2d p_WB = Eigen::Vector2d::Zero();

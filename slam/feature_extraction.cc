@@ -597,7 +597,8 @@ ScanFeatures ExtractFeatures(const LaserScan& scan, const FeatureExtractionParam
 
   // Corners: consecutive lines of one cluster (no range jump between them)
   // meeting at a large enough angle, with both seen segments ending near the
-  // intersection and neither running past it (slam/README.md, step 8).
+  // intersection, neither running past it, and the points between them on
+  // their lines (slam/README.md, step 8).
   const double min_sin_angle = std::sin(DegToRad(params.corner_min_angle_deg));
   int previous = -1;
   for (std::size_t i = 0; i < runs.size(); ++i) {
@@ -638,6 +639,23 @@ ScanFeatures ExtractFeatures(const LaserScan& scan, const FeatureExtractionParam
       continue;
     }
 
+    // No point between the two seen segments (points dropped near the vertex)
+    // may lie far behind the line on its side of the vertex. Where an
+    // occluder's face ends in front of a wall, the beams between the face's
+    // end and the intersection hit the wall behind the face's line; at a real
+    // vertex they hit the line itself. One-sided, at twice the gate, so that
+    // noise outliers (which is why most of these points were dropped) pass.
+    const double scan_turn = increment > 0.0 ? 1.0 : -1.0;
+    bool behind = false;
+    for (int j = run_a.last + 1; j < run_b.first && !behind; ++j) {
+      const ScanPoint& p = points[j];
+      const bool before_vertex = scan_turn * (p.x * p_SC.y() - p.y * p_SC.x()) > 0.0;
+      const LineFit& own = before_vertex ? run_a.fit : run_b.fit;
+      const double sigma = std::sqrt(PerpendicularVariance(p, own.cos_alpha, own.sin_alpha, noise));
+      behind = SignedDistance(own, p.x, p.y) > 2.0 * gate * sigma;
+    }
+    if (behind) continue;
+
     // Kind: at a convex corner each wall's far end lies beyond the other
     // wall's line (away from the sensor); at a concave one on the sensor side.
     const double beyond_a = SignedDistance(run_a.fit, line_b.p_SB.x(), line_b.p_SB.y());
@@ -651,8 +669,9 @@ ScanFeatures ExtractFeatures(const LaserScan& scan, const FeatureExtractionParam
     const Eigen::Matrix2d point_covariance = J_vertex * lines_covariance * J_vertex.transpose();
     Eigen::Matrix2d J_polar;
     const Eigen::Vector2d range_bearing = PointToRangeBearing(p_SC, &J_polar);
-    Eigen::Matrix2d covariance = J_polar * point_covariance * J_polar.transpose();
-    covariance = 0.5 * (covariance + covariance.transpose());
+    const Eigen::Matrix2d propagated = J_polar * point_covariance * J_polar.transpose();
+    // Symmetrised from a separate matrix (in place, Eigen's transpose aliases).
+    Eigen::Matrix2d covariance = 0.5 * (propagated + propagated.transpose());
     covariance(0, 0) += kCovarianceFloor;
     covariance(1, 1) += kCovarianceFloor;
 

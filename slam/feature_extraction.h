@@ -58,7 +58,7 @@ struct FeatureExtractionParams {
   double line_alpha_floor_std_deg = 0.005;
 
   /// Two neighbouring lines of one cluster meet at a corner only when the
-  /// acute angle between them is at least this, degrees (in [0, 90]).
+  /// acute angle between them is at least this, degrees (in (0, 90]).
   double corner_min_angle_deg = 30.0;
   /// ... and when each line's seen segment stops short of the intersection
   /// point by at most this distance, metres, plus `corner_endpoint_spacings`
@@ -101,9 +101,11 @@ struct FeatureExtractionParams {
 /// total-least-squares fit in polar form with its (rho, alpha) covariance
 /// propagated from the beam noise (Pfister et al. 2003; Arras & Siegwart 1997).
 /// Each beam point belongs to at most one line, so lines are independent.
-/// Corners: two neighbouring lines of one cluster whose seen segments both end
-/// near their intersection, at a large enough angle; covariance propagated from
-/// the two lines. Details and departures from the sources: slam/README.md.
+/// Corners: two neighbouring lines of one cluster, at a large enough angle,
+/// whose seen segments both end near their intersection, neither running past
+/// it, with no point between them behind their lines (so not an occlusion
+/// edge); covariance propagated from the two lines. Details and departures
+/// from the sources: slam/README.md.
 ///
 /// Lines are ordered by first beam; corners by the lines they join. Pure: no
 /// state, no randomness. Never throws because of the scan: an empty scan, an
@@ -126,7 +128,7 @@ Eigen::Vector2d IntersectLines(const Eigen::Vector2d& line_a,
                                Eigen::Matrix<double, 2, 4>* J = nullptr);
 
 /// A point p_SC in S as (range, bearing) = (|p|, atan2(y, x)), metres and
-/// radians. If `J` is not null it receives d(range, bearing)/d(x, y).
+/// radians, the bearing in (-pi, pi]. If `J` is not null it receives d(range, bearing)/d(x, y).
 /// Precondition: p_SC is not the origin; checked.
 Eigen::Vector2d PointToRangeBearing(const Eigen::Vector2d& p_SC,
                                     Eigen::Matrix2d* J = nullptr);

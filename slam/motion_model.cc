@@ -52,10 +52,15 @@ MotionInput OdometryInput(const Pose2& X_OR_previous, const Pose2& X_OR,
   input.increment = Eigen::Vector2d(X_R0R1.x, X_R0R1.theta);
   const double distance = std::abs(X_R0R1.x);
   const double turn = std::abs(X_R0R1.theta);
-  const double sigma_d = noise.distance_noise_std_m + noise.distance_noise_fraction * distance;
-  const double sigma_th = noise.heading_noise_std_rad + noise.heading_noise_fraction * turn +
-                          noise.heading_noise_per_distance_radpm * distance;
-  input.covariance = Eigen::Vector2d(sigma_d * sigma_d, sigma_th * sigma_th).asDiagonal();
+  // Random-walk slip: variances linear in the distance rolled and the angle turned.
+  const double variance_d =
+      noise.distance_noise_std_m * noise.distance_noise_std_m +
+      noise.distance_noise_std_m_per_sqrt_m * noise.distance_noise_std_m_per_sqrt_m * distance;
+  const double variance_th =
+      noise.heading_noise_std_rad * noise.heading_noise_std_rad +
+      noise.heading_noise_std_rad_per_sqrt_m * noise.heading_noise_std_rad_per_sqrt_m * distance +
+      noise.heading_noise_std_rad_per_sqrt_rad * noise.heading_noise_std_rad_per_sqrt_rad * turn;
+  input.covariance = Eigen::Vector2d(variance_d, variance_th).asDiagonal();
   return input;
 }
 

@@ -19,10 +19,10 @@ std::vector<ParamProblem> CommandNoiseParams::Validate() const {
 std::vector<ParamProblem> OdometryNoiseParams::Validate() const {
   ParamChecker check;
   check.NonNegative("distance_noise_std_m", distance_noise_std_m);
-  check.NonNegative("distance_noise_fraction", distance_noise_fraction);
+  check.NonNegative("distance_noise_std_m_per_sqrt_m", distance_noise_std_m_per_sqrt_m);
   check.NonNegative("heading_noise_std_rad", heading_noise_std_rad);
-  check.NonNegative("heading_noise_fraction", heading_noise_fraction);
-  check.NonNegative("heading_noise_per_distance_radpm", heading_noise_per_distance_radpm);
+  check.NonNegative("heading_noise_std_rad_per_sqrt_m", heading_noise_std_rad_per_sqrt_m);
+  check.NonNegative("heading_noise_std_rad_per_sqrt_rad", heading_noise_std_rad_per_sqrt_rad);
   return check.problems();
 }
 

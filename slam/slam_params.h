@@ -39,32 +39,35 @@ struct CommandNoiseParams {
 };
 
 /// Noise of the wheel-odometry increment as the filter's input (`input:
-/// odometry`), per record, one standard deviation each, with d the distance
-/// increment (m) and dth the heading increment (rad) between two records:
-/// sigma_d = distance_noise_std_m + distance_noise_fraction |d|,
-/// sigma_dth = heading_noise_std_rad + heading_noise_fraction |dth|
-///             + heading_noise_per_distance_radpm |d|.
-/// Serialized under `slam.ekf.odometry_noise.*`.
+/// odometry`), per record, with d the distance increment (m) and dth the
+/// heading increment (rad) between two records. Wheel slip is a random walk:
+/// its variance grows with the distance rolled and the angle turned, not with
+/// their squares (so the model does not depend on the record rate):
+///   sigma_d^2   = distance_noise_std_m^2 + distance_noise_std_m_per_sqrt_m^2 |d|,
+///   sigma_dth^2 = heading_noise_std_rad^2 + heading_noise_std_rad_per_sqrt_m^2 |d|
+///                 + heading_noise_std_rad_per_sqrt_rad^2 |dth|.
+/// The defaults are twice the simulator's default slip (0.5 % of a metre per
+/// wheel, 0.33 m track: 0.0035 m and 0.021 rad after 1 m, 0.0087 rad after
+/// 1 rad turned). Serialized under `slam.ekf.odometry_noise.*`.
 struct OdometryNoiseParams {
-  /// Constant part of the distance-increment noise per record, metres.
-  double distance_noise_std_m = 0.001;
-  /// Part of the distance-increment noise proportional to |d|.
-  double distance_noise_fraction = 0.05;
-  /// Constant part of the heading-increment noise per record, radians.
-  double heading_noise_std_rad = 0.001;
-  /// Part of the heading-increment noise proportional to |dth|.
-  double heading_noise_fraction = 0.05;
-  /// Part of the heading-increment noise proportional to the distance
-  /// travelled (wheel-radius mismatch, slip), rad per metre.
-  double heading_noise_per_distance_radpm = 0.02;
+  /// Noise floor of the distance increment per record, metres.
+  double distance_noise_std_m = 0.0005;
+  /// Standard deviation of the distance after 1 m rolled, m per sqrt(m).
+  double distance_noise_std_m_per_sqrt_m = 0.007;
+  /// Noise floor of the heading increment per record, radians.
+  double heading_noise_std_rad = 0.0005;
+  /// Standard deviation of the heading after 1 m rolled, rad per sqrt(m).
+  double heading_noise_std_rad_per_sqrt_m = 0.04;
+  /// Standard deviation of the heading after 1 rad turned, rad per sqrt(rad).
+  double heading_noise_std_rad_per_sqrt_rad = 0.02;
 
   template <typename Archive>
   void Serialize(Archive* a) {
     a->Visit(MJSLAM_NVP(distance_noise_std_m));
-    a->Visit(MJSLAM_NVP(distance_noise_fraction));
+    a->Visit(MJSLAM_NVP(distance_noise_std_m_per_sqrt_m));
     a->Visit(MJSLAM_NVP(heading_noise_std_rad));
-    a->Visit(MJSLAM_NVP(heading_noise_fraction));
-    a->Visit(MJSLAM_NVP(heading_noise_per_distance_radpm));
+    a->Visit(MJSLAM_NVP(heading_noise_std_rad_per_sqrt_m));
+    a->Visit(MJSLAM_NVP(heading_noise_std_rad_per_sqrt_rad));
   }
   /// Every out-of-range field, keys relative to this struct.
   std::vector<ParamProblem> Validate() const;
@@ -81,7 +84,7 @@ struct EkfParams {
   std::string input = "command";
   /// Offset `a` of the point of control h (frame R) ahead of the wheel axle,
   /// metres (> 0). Must match the robot's (`robot.control_point_offset_m`).
-  double control_point_offset_m = 0.15;
+  double control_point_offset_m = 0.2;
   /// Input noise when `input` is "command".
   CommandNoiseParams command_noise;
   /// Input noise when `input` is "odometry".
@@ -142,7 +145,9 @@ struct EkfParams {
 /// Everything the SLAM needs: feature extraction and filter parameters.
 /// Serialized under `slam.*` (`slam.features.*`, `slam.ekf.*`).
 struct SlamParams {
+  /// Line and corner extraction (`slam.features.*`).
   FeatureExtractionParams features;
+  /// The filters (`slam.ekf.*`).
   EkfParams ekf;
 
   template <typename Archive>

@@ -33,8 +33,11 @@ class SlamState {
   struct Measurement {
     /// False when the model is undefined (a corner at the sensor position).
     bool valid = false;
+    /// The predicted observation in S: (rho, alpha) or (range, bearing).
     Eigen::Vector2d h = Eigen::Vector2d::Zero();
+    /// d h / d(x, y, th) of R.
     Eigen::Matrix<double, 2, 3> H_pose = Eigen::Matrix<double, 2, 3>::Zero();
+    /// d h / d feature.
     Eigen::Matrix2d H_feature = Eigen::Matrix2d::Zero();
     /// H P H^T over the 5x5 block of the pose and the feature.
     Eigen::Matrix2d HPHt = Eigen::Matrix2d::Zero();

@@ -310,11 +310,23 @@ TEST(MotionModelTest, OdometryInputIsTheIncrementInThePreviousFrame) {
   const MotionInput input = OdometryInput(previous, current, noise);
   EXPECT_NEAR(input.increment.x(), 0.3, 1e-12);
   EXPECT_NEAR(input.increment.y(), 0.2, 1e-12);
-  const double sigma_d = noise.distance_noise_std_m + noise.distance_noise_fraction * 0.3;
-  const double sigma_th = noise.heading_noise_std_rad + noise.heading_noise_fraction * 0.2 +
-                          noise.heading_noise_per_distance_radpm * 0.3;
-  EXPECT_NEAR(input.covariance(0, 0), sigma_d * sigma_d, 1e-15);
-  EXPECT_NEAR(input.covariance(1, 1), sigma_th * sigma_th, 1e-15);
+  const double variance_d = std::pow(noise.distance_noise_std_m, 2) +
+                            std::pow(noise.distance_noise_std_m_per_sqrt_m, 2) * 0.3;
+  const double variance_th = std::pow(noise.heading_noise_std_rad, 2) +
+                             std::pow(noise.heading_noise_std_rad_per_sqrt_m, 2) * 0.3 +
+                             std::pow(noise.heading_noise_std_rad_per_sqrt_rad, 2) * 0.2;
+  EXPECT_NEAR(input.covariance(0, 0), variance_d, 1e-15);
+  EXPECT_NEAR(input.covariance(1, 1), variance_th, 1e-15);
+  // Random walk: two records of half the motion add up to the same variance
+  // as one (up to the per-record floors).
+  OdometryNoiseParams no_floor = noise;
+  no_floor.distance_noise_std_m = 0.0;
+  no_floor.heading_noise_std_rad = 0.0;
+  const Pose2 half = previous * Pose2(0.15, 0.0, 0.1);
+  const Eigen::Matrix2d one = OdometryInput(previous, previous * Pose2(0.3, 0.0, 0.2), no_floor).covariance;
+  const Eigen::Matrix2d two = OdometryInput(previous, half, no_floor).covariance +
+                              OdometryInput(half, half * Pose2(0.15, 0.0, 0.1), no_floor).covariance;
+  EXPECT_NEAR((one - two).norm(), 0.0, 1e-15);
   // The heading increment is wrapped across +-pi.
   const MotionInput across = OdometryInput(Pose2(0, 0, 3.1), Pose2(0, 0, -3.1), noise);
   EXPECT_NEAR(across.increment.y(), 2.0 * kPi - 6.2, 1e-12);
