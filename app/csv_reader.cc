@@ -35,6 +35,7 @@ CsvTable ReadCsv(const std::string& path, const std::vector<std::string>& text_c
   table.path = path;
   std::string line;
   if (!std::getline(in, line)) throw std::runtime_error(path + ": empty file, expected a header");
+  if (!line.empty() && line.back() == '\r') line.pop_back();  // CRLF line ends
   table.columns = SplitFields(line);
   std::vector<bool> is_text(table.columns.size(), false);
   for (std::size_t i = 0; i < table.columns.size(); ++i) {
@@ -43,6 +44,7 @@ CsvTable ReadCsv(const std::string& path, const std::vector<std::string>& text_c
   int line_number = 1;
   while (std::getline(in, line)) {
     ++line_number;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
     if (line.empty()) continue;
     const std::vector<std::string> fields = SplitFields(line);
     if (fields.size() != table.columns.size()) {

@@ -107,7 +107,6 @@ void Replay(const RunConfig& config, const ReplayOptions& options) {
     SlamPair slam(config.slam, X_WR0, X_RS);
     CsvWriter trajectory(dir + "/trajectory.csv", TrajectoryColumns());
     Progress progress("replay", static_cast<double>(input.rows.size()));
-    const double fov_rad = DegToRad(config.laser.fov_deg);
     Twist2 held;
     double previous_t = input.rows.front()[t_col];
     for (std::size_t i = 0; i < input.rows.size(); ++i) {
@@ -116,14 +115,14 @@ void Replay(const RunConfig& config, const ReplayOptions& options) {
       record.t_s = row[t_col];
       record.dt_s = i == 0 ? 0.0 : record.t_s - previous_t;
       record.command = held;
-      record.X_OR = X_WR0.Inverse() * pose_at(row, odom_col);
+      record.X_OR = pose_at(row, odom_col);
       auto it = scan_at.find(record.t_s);
       record.has_scan = it != scan_at.end();
       if (record.has_scan) {
         LaserScan& scan = record.scan;
         scan.t_s = record.t_s;
-        scan.angle_min_rad = -fov_rad / 2.0;
-        scan.angle_increment_rad = fov_rad / (num_beams - 1);
+        scan.angle_min_rad = config.laser.AngleMinRad();
+        scan.angle_increment_rad = config.laser.AngleIncrementRad();
         scan.max_range_m = config.laser.max_range_m;
         scan.ranges_m.assign(it->second->begin() + 4, it->second->end());
         scan.has_return.resize(num_beams);

@@ -90,6 +90,7 @@ RunResult RunSimulation(const RunConfig& config, const RunOptions& options) {
     const int steps_per_scan = config.StepsPerScan();
     Progress progress("run", num_steps);
     Twist2 applied;  // the command held during the last period
+    double previous_t = 0.0;
     result.status = "completed";
 
     for (int step = 0; step <= num_steps; ++step) {
@@ -103,9 +104,11 @@ RunResult RunSimulation(const RunConfig& config, const RunOptions& options) {
       // What the robot reports: odometry, the command it held, maybe a scan.
       SensorRecord record;
       record.t_s = t;
-      record.dt_s = step == 0 ? 0.0 : dt;
+      record.dt_s = step == 0 ? 0.0 : t - previous_t;  // as a replay computes it
       record.command = applied;
-      record.X_OR = odometry.Update(simulator.WheelAngles());
+      // The odometry pose as written to trajectory.csv (frame O placed at the
+      // start pose in W), so that a replay feeds the filters the same bits.
+      record.X_OR = X_WR0 * odometry.Update(simulator.WheelAngles());
       record.has_scan = step % steps_per_scan == 0;
       if (record.has_scan) {
         const std::vector<double> jitter = laser_noise.DrawAngleOffsets();
@@ -126,7 +129,7 @@ RunResult RunSimulation(const RunConfig& config, const RunOptions& options) {
       // The driver steers from the true pose until the explorer exists.
       applied = simulator.SetCommand(driver.Command(X_WR, dt));
 
-      const Pose2 X_WR_odometry = X_WR0 * record.X_OR;
+      const Pose2& X_WR_odometry = record.X_OR;
       trajectory.Add(t);
       for (const double v : {X_WR.x, X_WR.y, X_WR.theta, X_WR_odometry.x, X_WR_odometry.y,
                              X_WR_odometry.theta, applied.v_mps, applied.w_radps}) {
@@ -135,6 +138,7 @@ RunResult RunSimulation(const RunConfig& config, const RunOptions& options) {
       slam.AddColumns(&trajectory);
       trajectory.EndRow();
 
+      previous_t = t;
       result.steps = step + 1;
       result.sim_time_s = t;
       progress.Update(step);

@@ -21,8 +21,9 @@ struct SensorRecord {
   double dt_s = 0.0;
   /// The command that was applied to the robot during the last `dt_s`.
   Twist2 command;
-  /// Wheel-odometry pose of frame R in the odometry frame O (O = the start
-  /// pose), integrated from the wheel encoders.
+  /// Wheel-odometry pose of frame R in a fixed odometry frame O, integrated
+  /// from the wheel encoders (mjslam places O so that X_OR starts at the true
+  /// start pose in W; the filters use only its increments).
   Pose2 X_OR;
   /// Whether `scan` holds a new sweep.
   bool has_scan = false;

@@ -39,7 +39,16 @@ LaserScan LaserNoise::Apply(const LaserScan& exact) {
       noisy.has_return[i] = 0;
       continue;
     }
-    noisy.ranges_m[i] = std::clamp(exact.ranges_m[i] + error, 0.0, max_range);
+    // An echo is a range strictly below the maximum: noise that carries a
+    // range to the maximum or beyond turns it into a no-return, as on the
+    // SICK, so a recorded scan says the same thing without its flags.
+    const double range = std::max(exact.ranges_m[i] + error, 0.0);
+    if (range >= max_range) {
+      noisy.ranges_m[i] = max_range;
+      noisy.has_return[i] = 0;
+    } else {
+      noisy.ranges_m[i] = range;
+    }
   }
   return noisy;
 }

@@ -567,7 +567,7 @@ LaserScan Simulator::CastLaser(const LaserParams& laser,
     const mjtNum direction[3] = {std::cos(bearing_W), std::sin(bearing_W), 0.0};
     int geom = -1;
     const mjtNum distance = mj_ray(m, d, origin, direction, geom_groups, 1, -1, &geom);
-    if (distance >= 0.0 && distance <= laser.max_range_m) {
+    if (distance >= 0.0 && distance < laser.max_range_m) {
       scan.ranges_m[i] = distance;
       scan.has_return[i] = 1;
     }

@@ -182,7 +182,10 @@ StepReport EkfSlam::Step(const SensorRecord& record, const ScanFeatures* feature
       throw SlamInputError("EkfSlam::Step: record.X_OR: expected a finite pose (got " +
                            PoseText(record.X_OR) + ")");
     }
-    input = OdometryInput(X_OR_previous_, record.X_OR, params_.odometry_noise);
+    // The first record is the reference of the odometry increments.
+    const Pose2& X_OR_previous = has_odometry_ ? X_OR_previous_ : record.X_OR;
+    input = OdometryInput(X_OR_previous, record.X_OR, params_.control_point_offset_m,
+                          params_.odometry_noise);
   } else {
     RequireFinite(record.command.v_mps, "record.command.v_mps");
     RequireFinite(record.command.w_radps, "record.command.w_radps");
@@ -192,7 +195,10 @@ StepReport EkfSlam::Step(const SensorRecord& record, const ScanFeatures* feature
   if (features != nullptr) observations = CollectObservations(*features);
 
   // Prediction, Eqs. (1)-(2) with (6).
-  if (use_odometry) X_OR_previous_ = record.X_OR;
+  if (use_odometry) {
+    X_OR_previous_ = record.X_OR;
+    has_odometry_ = true;
+  }
   state_.Predict(input, params_.control_point_offset_m);
 
   StepReport report;

@@ -81,8 +81,9 @@ class EkfSlam {
  public:
   /// X_WR0: known initial pose of R (the point of control h) in W; its
   /// covariance is from `params` (zero by default, as in the paper). X_RS:
-  /// the laser mount on R. With `input: odometry`, the odometry frame O is
-  /// R's start pose (X_OR = identity before the first record).
+  /// the laser mount on R. With `input: odometry`, only the increments of
+  /// X_OR between consecutive records enter, so any fixed frame O works; the
+  /// first record is their reference (it predicts no motion).
   /// Throws ParamError if `params` is invalid and SlamInputError if a pose is
   /// not finite.
   EkfSlam(const EkfParams& params, CorrectionMode mode, const Pose2& X_WR0, const Pose2& X_RS);
@@ -144,6 +145,7 @@ class EkfSlam {
   double gate_;
   double new_feature_threshold_;
   Pose2 X_OR_previous_;
+  bool has_odometry_ = false;  // whether X_OR_previous_ holds a record's pose
   std::vector<FeatureInfo> info_;
   int next_id_ = 0;
 };

@@ -493,9 +493,14 @@ ScanFeatures ExtractFeatures(const LaserScan& scan, const FeatureExtractionParam
 
   // Each point belongs to at most one line: a split point shared by two runs
   // (the point nearest the vertex) goes to neither, so the lines' errors are
-  // independent.
+  // independent, and no line ever takes it back: it may lie on either wall,
+  // and on the other wall a few millimetres from the vertex it passes every
+  // residual test of this one while tilting its fit (a beam grazing the end
+  // face of a wall, next to a convex corner).
+  std::vector<char> is_vertex(points.size(), 0);
   for (std::size_t i = 0; i + 1 < runs.size(); ++i) {
     if (runs[i].cluster == runs[i + 1].cluster && runs[i].last == runs[i + 1].first) {
+      is_vertex[runs[i].last] = 1;
       --runs[i].last;
       ++runs[i + 1].first;
     }
@@ -554,8 +559,8 @@ ScanFeatures ExtractFeatures(const LaserScan& scan, const FeatureExtractionParam
     }
   }
 
-  // Grow the ends into points that no line holds (split points, runs too
-  // short to be lines): a point joins when it fits the line within the gate
+  // Grow the ends into points that no line holds (points trimmed above, runs
+  // too short to be lines; never a vertex point): a point joins when it fits the line within the gate
   // and does not fit the neighbouring line (not ambiguous); refit after each.
   for (std::size_t i = 0; i < runs.size(); ++i) {
     Segment& run = runs[i];
@@ -564,12 +569,12 @@ ScanFeatures ExtractFeatures(const LaserScan& scan, const FeatureExtractionParam
     const Segment* after = valid_after(i);
     const int lowest = before != nullptr ? before->last + 1 : cluster_bounds[run.cluster].first;
     const int highest = after != nullptr ? after->first - 1 : cluster_bounds[run.cluster].second;
-    while (run.valid && run.first > lowest &&
+    while (run.valid && run.first > lowest && is_vertex[run.first - 1] == 0 &&
            !RejectsPoint(run.fit, points[run.first - 1], before, noise, gate)) {
       --run.first;
       refit(&run);
     }
-    while (run.valid && run.last < highest &&
+    while (run.valid && run.last < highest && is_vertex[run.last + 1] == 0 &&
            !RejectsPoint(run.fit, points[run.last + 1], after, noise, gate)) {
       ++run.last;
       refit(&run);

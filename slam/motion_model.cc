@@ -9,24 +9,36 @@ namespace mjslam::slam {
 
 Eigen::Vector3d PredictPose(const Eigen::Vector3d& pose_WR, const Eigen::Vector2d& increment,
                             double a_m, Eigen::Matrix3d* A, Eigen::Matrix<double, 3, 2>* W) {
-  const double c = std::cos(pose_WR.z());
-  const double s = std::sin(pose_WR.z());
   const double d = increment.x();
   const double dth = increment.y();
-
-  // Eq. (6): the velocity of h is (u, a w) in R, integrated with the heading
-  // at the start of the period (forward Euler, as in the paper).
-  const Eigen::Vector3d predicted(pose_WR.x() + d * c - a_m * dth * s,
-                                  pose_WR.y() + d * s + a_m * dth * c,
+  const double half = 0.5 * dth;
+  const double th_mid = pose_WR.z() + half;
+  const double cm = std::cos(th_mid);
+  const double sm = std::sin(th_mid);
+  // sinc(half) and its derivative with respect to dth.
+  double sinc, dsinc;
+  if (std::abs(half) < 1e-4) {
+    sinc = 1.0 - half * half / 6.0;
+    dsinc = -half / 6.0;
+  } else {
+    sinc = std::sin(half) / half;
+    dsinc = 0.5 * (half * std::cos(half) - std::sin(half)) / (half * half);
+  }
+  const double chord = d * sinc;
+  const double lateral = 2.0 * a_m * std::sin(half);
+  const double dx = chord * cm - lateral * sm;
+  const double dy = chord * sm + lateral * cm;
+  const Eigen::Vector3d predicted(pose_WR.x() + dx, pose_WR.y() + dy,
                                   WrapAngleFast(pose_WR.z() + dth));
   if (A != nullptr) {
     A->setIdentity();
-    (*A)(0, 2) = -d * s - a_m * dth * c;
-    (*A)(1, 2) = d * c - a_m * dth * s;
+    (*A)(0, 2) = -dy;
+    (*A)(1, 2) = dx;
   }
   if (W != nullptr) {
-    *W << c, -a_m * s,
-          s, a_m * c,
+    const double dlat = a_m * std::cos(half);
+    *W << sinc * cm, d * dsinc * cm - dlat * sm - 0.5 * dy,
+          sinc * sm, d * dsinc * sm + dlat * cm + 0.5 * dx,
           0.0, 1.0;
   }
   return predicted;
@@ -44,13 +56,21 @@ MotionInput CommandInput(const Twist2& command, double dt_s, const CommandNoiseP
   return input;
 }
 
-MotionInput OdometryInput(const Pose2& X_OR_previous, const Pose2& X_OR,
+MotionInput OdometryInput(const Pose2& X_OR_previous, const Pose2& X_OR, double a_m,
                           const OdometryNoiseParams& noise) {
-  // The motion of R between the two records, in the previous R frame.
+  // The motion of R between the two records, in the previous R frame, and
+  // that of the axle centre (a_m behind R): a chord of the arc, at half the
+  // heading change.
   const Pose2 X_R0R1 = X_OR_previous.Inverse() * X_OR;
+  const double dth = X_R0R1.theta;
+  const double half = 0.5 * dth;
+  const double axle_dx = X_R0R1.x - a_m * (std::cos(dth) - 1.0);
+  const double axle_dy = X_R0R1.y - a_m * std::sin(dth);
+  const double chord = axle_dx * std::cos(half) + axle_dy * std::sin(half);
+  const double sinc = std::abs(half) < 1e-4 ? 1.0 - half * half / 6.0 : std::sin(half) / half;
   MotionInput input;
-  input.increment = Eigen::Vector2d(X_R0R1.x, X_R0R1.theta);
-  const double distance = std::abs(X_R0R1.x);
+  input.increment = Eigen::Vector2d(chord / sinc, dth);
+  const double distance = std::abs(input.increment.x());
   const double turn = std::abs(X_R0R1.theta);
   // Random-walk slip: variances linear in the distance rolled and the angle turned.
   const double variance_d =

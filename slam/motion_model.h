@@ -34,12 +34,11 @@ Eigen::Vector3d PredictPose(const Eigen::Vector3d& pose_WR, const Eigen::Vector2
 MotionInput CommandInput(const Twist2& command, double dt_s, const CommandNoiseParams& noise);
 
 /// The wheel-odometry increment between two records as the equivalent input:
-/// with (dx, dy, dth) = X_OR_previous^-1 * X_OR (the motion of R in the
-/// previous R frame), the increment is (dx, dth): the forward distance and
-/// the heading change, the input that Eq. (6) turns into the same forward
-/// motion and heading (the lateral motion a dth is Eq. (6)'s own).
-/// Covariance from `noise` (OdometryNoiseParams documents it).
-MotionInput OdometryInput(const Pose2& X_OR_previous, const Pose2& X_OR,
+/// the (d, dth) that PredictPose with offset `a_m` turns into the motion
+/// X_OR_previous^-1 * X_OR (exactly when that motion is a unicycle arc of the
+/// axle centre; its lateral slip, if any, is dropped). Covariance from
+/// `noise` (OdometryNoiseParams documents it).
+MotionInput OdometryInput(const Pose2& X_OR_previous, const Pose2& X_OR, double a_m,
                           const OdometryNoiseParams& noise);
 
 }  // namespace mjslam::slam

@@ -69,6 +69,17 @@ TEST(CsvTest, EmptyFieldsReadAsNan) {
   EXPECT_TRUE(std::isnan(table.rows[0][2]));
 }
 
+TEST(CsvTest, ReadsWindowsLineEnds) {
+  // Files saved by spreadsheets and Python's csv module end lines with CRLF.
+  const std::string path = TempPath("crlf.csv");
+  std::ofstream(path) << "a,b\r\n1,2.5\r\n3,\r\n";
+  const CsvTable table = ReadCsv(path);
+  EXPECT_EQ(table.columns, (std::vector<std::string>{"a", "b"}));
+  ASSERT_EQ(table.rows.size(), 2u);
+  EXPECT_EQ(table.rows[0][1], 2.5);
+  EXPECT_TRUE(std::isnan(table.rows[1][1]));
+}
+
 TEST(CsvTest, BadInputNamesFileLineAndColumn) {
   const std::string path = TempPath("bad.csv");
   std::ofstream(path) << "t,x\n0,1\n0.1,abc\n";

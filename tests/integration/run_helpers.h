@@ -2,6 +2,7 @@
 
 // Helpers of the integration tests: run the mjslam program, read its files.
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <cstdlib>
 #include <filesystem>
@@ -14,9 +15,11 @@
 
 namespace mjslam::testing {
 
-/// A fresh, empty folder under the temporary directory.
+/// A fresh, empty folder under the temporary directory, private to this
+/// process (ctest runs tests of one suite in parallel processes).
 inline std::string FreshDir(const std::string& name) {
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "mjslam_it" / name;
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "mjslam_it" /
+                                    std::to_string(::getpid()) / name;
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir.string();

@@ -116,19 +116,35 @@ TEST(LaserNoiseTest, RangesStayWithinZeroAndMaxRange) {
   laser.max_range_m = 10.0;
   laser.range_noise_std_m = 0.5;
   LaserNoise noise(laser, Rng(3));
-  for (const double range : {0.01, 9.99}) {
-    bool clamped = false;
-    for (int scan = 0; scan < 20; ++scan) {
-      const LaserScan noisy = noise.Apply(ExactScan(laser, range));
-      for (int i = 0; i < noisy.size(); ++i) {
-        EXPECT_GE(noisy.ranges_m[i], 0.0);
-        EXPECT_LE(noisy.ranges_m[i], 10.0);
-        EXPECT_EQ(noisy.has_return[i], 1);  // clamped echoes are still echoes
-        clamped = clamped || noisy.ranges_m[i] == 0.0 || noisy.ranges_m[i] == 10.0;
+  // Near zero: echoes clamped at 0 stay echoes.
+  bool clamped = false;
+  for (int scan = 0; scan < 20; ++scan) {
+    const LaserScan noisy = noise.Apply(ExactScan(laser, 0.01));
+    for (int i = 0; i < noisy.size(); ++i) {
+      EXPECT_GE(noisy.ranges_m[i], 0.0);
+      EXPECT_EQ(noisy.has_return[i], 1);
+      clamped = clamped || noisy.ranges_m[i] == 0.0;
+    }
+  }
+  EXPECT_TRUE(clamped);
+  // Near the maximum: an echo is a range strictly below it; noise that
+  // reaches the maximum makes a no-return at the maximum range.
+  int echoes = 0;
+  int lost = 0;
+  for (int scan = 0; scan < 20; ++scan) {
+    const LaserScan noisy = noise.Apply(ExactScan(laser, 9.99));
+    for (int i = 0; i < noisy.size(); ++i) {
+      if (noisy.has_return[i]) {
+        ++echoes;
+        EXPECT_LT(noisy.ranges_m[i], 10.0);
+      } else {
+        ++lost;
+        EXPECT_EQ(noisy.ranges_m[i], 10.0);
       }
     }
-    EXPECT_TRUE(clamped) << "range " << range;
   }
+  EXPECT_GT(echoes, 0);
+  EXPECT_GT(lost, 0);
 }
 
 TEST(LaserNoiseTest, NoReturnBeamsStayNoReturns) {

@@ -100,7 +100,7 @@ std::vector<std::optional<double>> AnalyticRanges(const Pose2& X_WS, const Laser
     std::optional<double> best;
     for (const TestObstacle& o : obstacles) {
       const std::optional<double> hit = RayHit(X_WS.translation(), u, o);
-      if (hit && *hit <= laser.max_range_m && (!best || *hit < *best)) best = hit;
+      if (hit && *hit < laser.max_range_m && (!best || *hit < *best)) best = hit;
     }
     ranges.push_back(best);
   }

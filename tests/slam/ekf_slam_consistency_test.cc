@@ -79,11 +79,13 @@ RunErrors Run(CorrectionMode mode, std::uint64_t seed, double reported_variance_
       // composed as Eq. (6) moves R (so OdometryInput recovers it exactly).
       const Eigen::Matrix2d Q = OdometryInput(Pose2(), Pose2(true_increment.x(), 0.0,
                                                              true_increment.y()),
-                                              params.odometry_noise)
+                                              0.0, params.odometry_noise)
                                     .covariance;
       const double d = true_increment.x() + motion_rng.Gaussian(0.0, std::sqrt(Q(0, 0)));
       const double dth = true_increment.y() + motion_rng.Gaussian(0.0, std::sqrt(Q(1, 1)));
-      X_OR = X_OR * Pose2(d, params.control_point_offset_m * dth, dth);
+      const Eigen::Vector3d step = PredictPose(Eigen::Vector3d::Zero(), Eigen::Vector2d(d, dth),
+                                               params.control_point_offset_m);
+      X_OR = X_OR * Pose2(step.x(), step.y(), step.z());
     }
     record.X_OR = X_OR;
     const bool scan = step % kStepsPerScan == 0;

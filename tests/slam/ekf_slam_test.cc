@@ -3,6 +3,7 @@
 // neighbour, duplicate guard), both correction modes and the secondary map.
 
 #include "slam/ekf_slam.h"
+#include "slam/motion_model.h"
 
 #include <cmath>
 #include <limits>
@@ -161,7 +162,11 @@ TEST(EkfSlamTest, PredictsFromOdometry) {
   for (int i = 0; i < 50; ++i) {
     const double d = 0.05;
     const double dth = 0.04 * std::sin(0.1 * i);
-    X_OR = X_OR * Pose2(d, params.control_point_offset_m * dth, dth);
+    if (i > 0) {
+      const Eigen::Vector3d step = PredictPose(Eigen::Vector3d::Zero(), Eigen::Vector2d(d, dth),
+                                               params.control_point_offset_m);
+      X_OR = X_OR * Pose2(step.x(), step.y(), step.z());
+    }
     record.dt_s = i == 0 ? 0.0 : 0.1;
     record.X_OR = X_OR;
     record.command = Twist2{100.0, 100.0};  // ignored
@@ -172,6 +177,31 @@ TEST(EkfSlamTest, PredictsFromOdometry) {
   EXPECT_NEAR(filter.X_WR().y, expected.y, 1e-9);
   EXPECT_NEAR(WrapAngle(filter.X_WR().theta - expected.theta), 0.0, 1e-9);
   EXPECT_GT(filter.pose_covariance().determinant(), 0.0);
+}
+
+TEST(EkfSlamTest, OdometryFrameIsArbitrary) {
+  // Only increments enter: odometry expressed in another fixed frame (and not
+  // starting at the identity) gives the same estimate.
+  EkfParams params;
+  params.input = "odometry";
+  const Pose2 X_WR0(1.0, 2.0, -0.3);
+  const Pose2 X_QO(-7.0, 4.0, 2.5);  // some other frame Q
+  EkfSlam in_O(params, CorrectionMode::kSelective, X_WR0, Pose2());
+  EkfSlam in_Q(params, CorrectionMode::kSelective, X_WR0, Pose2());
+  Pose2 X_OR;
+  for (int i = 0; i < 30; ++i) {
+    if (i > 0) X_OR = X_OR * Pose2(0.04, 0.01, 0.03);
+    SensorRecord record;
+    record.dt_s = i == 0 ? 0.0 : 0.1;
+    record.X_OR = X_OR;
+    in_O.Step(record, nullptr);
+    record.X_OR = X_QO * X_OR;
+    in_Q.Step(record, nullptr);
+  }
+  EXPECT_NEAR(in_O.X_WR().x, in_Q.X_WR().x, 1e-9);
+  EXPECT_NEAR(in_O.X_WR().y, in_Q.X_WR().y, 1e-9);
+  EXPECT_NEAR(WrapAngle(in_O.X_WR().theta - in_Q.X_WR().theta), 0.0, 1e-9);
+  EXPECT_GT(in_O.X_WR().Inverse().translation().norm(), 0.5);  // it did move
 }
 
 TEST(EkfSlamTest, FirstScanAddsFeaturesAndTheSecondMatchesThem) {

@@ -253,14 +253,26 @@ TEST(ObservationModelsTest, MountOffsetChangesThePrediction) {
   EXPECT_NEAR(with.x(), 1.5, 1e-12);
 }
 
-TEST(MotionModelTest, PredictionFollowsEquationSix) {
-  // Heading pi/2, d = 0.3, dth = 0.1, a = 0.2:
-  // x' = x + d cos th - a dth sin th = 1 - 0.02, y' = y + d sin th + a dth cos th = 2.3.
+TEST(MotionModelTest, PredictionIntegratesEquationSixExactly) {
+  // Heading pi/2, d = 0.3, dth = 0.1, a = 0.2. Eq. (6) with (u, w) held over
+  // the period: the axle centre moves on an arc of length d, the point h
+  // stays a ahead of it. Axle at (1, 1.8); it turns by 0.1 on a circle of
+  // radius d / dth = 3 about (-2, 1.8), ending at (-2 + 3 cos 0.1, 1.8 + 3 sin 0.1).
   const Eigen::Vector3d pose(1.0, 2.0, kPi / 2.0);
   const Eigen::Vector3d next = PredictPose(pose, Eigen::Vector2d(0.3, 0.1), 0.2);
-  EXPECT_NEAR(next.x(), 0.98, 1e-12);
-  EXPECT_NEAR(next.y(), 2.3, 1e-12);
-  EXPECT_NEAR(next.z(), kPi / 2.0 + 0.1, 1e-12);
+  const double th = kPi / 2.0 + 0.1;
+  EXPECT_NEAR(next.x(), -2.0 + 3.0 * std::cos(0.1) + 0.2 * std::cos(th), 1e-12);
+  EXPECT_NEAR(next.y(), 1.8 + 3.0 * std::sin(0.1) + 0.2 * std::sin(th), 1e-12);
+  EXPECT_NEAR(next.z(), th, 1e-12);
+  // Without turning it is a straight move of d along the heading.
+  const Eigen::Vector3d straight = PredictPose(pose, Eigen::Vector2d(0.3, 0.0), 0.2);
+  EXPECT_NEAR(straight.x(), 1.0, 1e-12);
+  EXPECT_NEAR(straight.y(), 2.3, 1e-12);
+  // Small steps agree with the paper's forward-Euler form to second order:
+  // x' = x + d cos th - a dth sin th, y' = y + d sin th + a dth cos th.
+  const Eigen::Vector3d small = PredictPose(pose, Eigen::Vector2d(3e-3, 1e-3), 0.2);
+  EXPECT_NEAR(small.x(), 1.0 - 0.2 * 1e-3, 1e-5);
+  EXPECT_NEAR(small.y(), 2.0 + 3e-3, 1e-5);
   // Heading is wrapped.
   const Eigen::Vector3d wrapped = PredictPose(Eigen::Vector3d(0, 0, 3.1), Eigen::Vector2d(0, 0.1), 0.2);
   EXPECT_NEAR(wrapped.z(), 3.2 - 2.0 * kPi, 1e-12);
@@ -304,10 +316,12 @@ TEST(MotionModelTest, CommandInputScalesWithDt) {
 
 TEST(MotionModelTest, OdometryInputIsTheIncrementInThePreviousFrame) {
   OdometryNoiseParams noise;
-  // From (1, 1, pi/2) to 0.3 m further along the heading, turned by 0.2.
+  // From (1, 1, pi/2), an arc of 0.3 m turning by 0.2 (a = 0.2): the input
+  // that PredictPose turns back into the same motion.
   const Pose2 previous(1.0, 1.0, kPi / 2.0);
-  const Pose2 current = previous * Pose2(0.3, 0.01, 0.2);
-  const MotionInput input = OdometryInput(previous, current, noise);
+  const Eigen::Vector3d step = PredictPose(Eigen::Vector3d::Zero(), Eigen::Vector2d(0.3, 0.2), 0.2);
+  const Pose2 current = previous * Pose2(step.x(), step.y(), step.z());
+  const MotionInput input = OdometryInput(previous, current, 0.2, noise);
   EXPECT_NEAR(input.increment.x(), 0.3, 1e-12);
   EXPECT_NEAR(input.increment.y(), 0.2, 1e-12);
   const double variance_d = std::pow(noise.distance_noise_std_m, 2) +
@@ -322,13 +336,17 @@ TEST(MotionModelTest, OdometryInputIsTheIncrementInThePreviousFrame) {
   OdometryNoiseParams no_floor = noise;
   no_floor.distance_noise_std_m = 0.0;
   no_floor.heading_noise_std_rad = 0.0;
-  const Pose2 half = previous * Pose2(0.15, 0.0, 0.1);
-  const Eigen::Matrix2d one = OdometryInput(previous, previous * Pose2(0.3, 0.0, 0.2), no_floor).covariance;
-  const Eigen::Matrix2d two = OdometryInput(previous, half, no_floor).covariance +
-                              OdometryInput(half, half * Pose2(0.15, 0.0, 0.1), no_floor).covariance;
-  EXPECT_NEAR((one - two).norm(), 0.0, 1e-15);
+  const auto arc = [](const Pose2& from, double d, double dth) {
+    const Eigen::Vector3d step = PredictPose(Eigen::Vector3d::Zero(), Eigen::Vector2d(d, dth), 0.2);
+    return from * Pose2(step.x(), step.y(), step.z());
+  };
+  const Pose2 half = arc(previous, 0.15, 0.1);
+  const Eigen::Matrix2d one = OdometryInput(previous, arc(previous, 0.3, 0.2), 0.2, no_floor).covariance;
+  const Eigen::Matrix2d two = OdometryInput(previous, half, 0.2, no_floor).covariance +
+                              OdometryInput(half, arc(half, 0.15, 0.1), 0.2, no_floor).covariance;
+  EXPECT_NEAR((one - two).norm(), 0.0, 1e-14);
   // The heading increment is wrapped across +-pi.
-  const MotionInput across = OdometryInput(Pose2(0, 0, 3.1), Pose2(0, 0, -3.1), noise);
+  const MotionInput across = OdometryInput(Pose2(0, 0, 3.1), Pose2(0, 0, -3.1), 0.2, noise);
   EXPECT_NEAR(across.increment.y(), 2.0 * kPi - 6.2, 1e-12);
 }
 
