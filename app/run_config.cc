@@ -33,6 +33,11 @@ std::vector<ParamProblem> RunConfig::Validate() const {
                   "a rate that divides run.control_rate_hz (" +
                       ValueText(run.control_rate_hz) + ")");
   }
+  // The filters predict the point h that the robot is driven by.
+  check.Require(slam.ekf.control_point_offset_m == robot.control_point_offset_m,
+                "slam.ekf.control_point_offset_m", slam.ekf.control_point_offset_m,
+                "robot.control_point_offset_m (" + ValueText(robot.control_point_offset_m) +
+                    "): the filters must predict the robot's point h");
   return check.problems();
 }
 

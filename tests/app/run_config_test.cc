@@ -52,6 +52,19 @@ TEST(RunConfigTest, LaserRateMustDivideControlRate) {
   }
 }
 
+TEST(RunConfigTest, FiltersMustPredictTheRobotsPointH) {
+  const std::string path = std::string(MJSLAM_SOURCE_DIR) + "/configs/default.yaml";
+  EXPECT_NO_THROW(LoadRunConfig(
+      path, {"robot.control_point_offset_m=0.15", "slam.ekf.control_point_offset_m=0.15"}));
+  try {
+    LoadRunConfig(path, {"robot.control_point_offset_m=0.15"});
+    FAIL() << "expected an error";
+  } catch (const std::exception& error) {
+    EXPECT_NE(std::string(error.what()).find("slam.ekf.control_point_offset_m"), std::string::npos)
+        << error.what();
+  }
+}
+
 TEST(RunConfigTest, AllProblemsReportedAtOnceWithPositions) {
   const fs::path dir = fs::temp_directory_path() / "mjslam_run_config_test";
   fs::create_directories(dir);
