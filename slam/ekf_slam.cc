@@ -191,6 +191,8 @@ StepReport EkfSlam::Step(const SensorRecord& record, const ScanFeatures* feature
     RequireFinite(record.command.w_radps, "record.command.w_radps");
     input = CommandInput(record.command, record.dt_s, params_.command_noise);
   }
+  const double slip_std = params_.lateral_slip_std_m_per_rad * std::abs(input.increment.y());
+  input.lateral_variance_m2 = slip_std * slip_std;
   std::vector<Observation> observations;
   if (features != nullptr) observations = CollectObservations(*features);
 
@@ -211,10 +213,24 @@ StepReport EkfSlam::Step(const SensorRecord& record, const ScanFeatures* feature
   // Data association against the predicted map.
   const Association association = AssociateNearestNeighbour(
       MahalanobisDistances(observations), gate_, new_feature_threshold_);
+  // Observations are the lines, then the corners (CollectObservations).
+  const int num_lines = static_cast<int>(features->lines.size());
+  auto line_matched = [&](int line) {
+    return line >= 0 && line < num_lines &&
+           association.outcome[line] == AssociationOutcome::kMatched;
+  };
   std::vector<MatchedObservation> matched;
   std::vector<int> matched_observation;
   for (int i = 0; i < report.num_observed; ++i) {
     if (association.outcome[i] == AssociationOutcome::kMatched) {
+      if (i >= num_lines && !params_.correct_corners_of_matched_lines) {
+        // The corner repeats what its two lines say when both correct too.
+        const CornerObservation& corner = features->corners[i - num_lines];
+        if (line_matched(corner.line_a) && line_matched(corner.line_b)) {
+          ++report.num_redundant_corners;
+          continue;
+        }
+      }
       matched.push_back({association.feature[i], observations[i].z, observations[i].R});
       matched_observation.push_back(i);
     } else if (association.outcome[i] == AssociationOutcome::kNew) {
@@ -223,7 +239,7 @@ StepReport EkfSlam::Step(const SensorRecord& record, const ScanFeatures* feature
       ++report.num_ambiguous;
     }
   }
-  report.num_matched = static_cast<int>(matched.size());
+  report.num_matched = static_cast<int>(matched.size()) + report.num_redundant_corners;
 
   // Correction: Algorithm 1 or 2.
   if (mode_ == CorrectionMode::kClassical) {

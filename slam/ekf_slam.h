@@ -32,7 +32,11 @@ struct StepReport {
   int num_observed = 0;
   /// Observations associated with a map feature.
   int num_matched = 0;
-  /// Corrections applied: num_matched (classical) or at most max_updates.
+  /// Matched corners left out of the correction because both their lines
+  /// matched too (EkfParams::correct_corners_of_matched_lines).
+  int num_redundant_corners = 0;
+  /// Corrections applied: num_matched - num_redundant_corners (classical) or
+  /// at most max_updates of those (selective).
   int num_updated = 0;
   /// Observations that became new features.
   int num_new = 0;

@@ -16,6 +16,10 @@ struct MotionInput {
   Eigen::Vector2d increment = Eigen::Vector2d::Zero();
   /// Covariance of `increment` (the paper's Q, scaled by dt^2 for commands).
   Eigen::Matrix2d covariance = Eigen::Matrix2d::Zero();
+  /// Variance of a sideways slip of R over the step, m^2: a displacement
+  /// across the mid-arc heading th + dth / 2 that Eq. (6) does not model,
+  /// independent of `increment` (EkfParams::lateral_slip_std_m_per_rad).
+  double lateral_variance_m2 = 0.0;
 };
 
 /// The paper's Eq. (6) for the point of control h (frame R, `a_m` ahead of

@@ -89,6 +89,14 @@ struct EkfParams {
   CommandNoiseParams command_noise;
   /// Input noise when `input` is "odometry".
   OdometryNoiseParams odometry_noise;
+  /// Lateral slip of R per radian turned, one standard deviation, metres per
+  /// radian, with either input: Eq. (6) has no sideways motion, but tyres
+  /// skid outward in turns. The prediction adds (k |dth|)^2 of variance
+  /// across the mid-arc heading. The simulator's robot skids about 0.0088 s
+  /// times v w sideways (0.2-0.3 mm per 0.1 s step in a 1.2 rad/s turn,
+  /// 2-3 mm per radian), always outward; the default covers that systematic
+  /// drift as noise (slam/README.md, departure 10).
+  double lateral_slip_std_m_per_rad = 0.005;
 
   /// Standard deviation of the initial position of R, metres (0: known start,
   /// as in the paper).
@@ -115,6 +123,14 @@ struct EkfParams {
   /// (2 dof) of this probability (>= gate_probability, < 1). Observations in
   /// between are neither matched nor added. 0.9999 gives 18.4.
   double new_feature_probability = 0.9999;
+  /// Whether a corner whose two lines both matched map features in the same
+  /// scan also corrects the state. A corner is the intersection of its two
+  /// lines, fitted to the same points: correcting with all three counts that
+  /// information twice and makes the filter overconfident. false (default):
+  /// such a corner is matched (and its segment bookkeeping kept) but left
+  /// out of the correction; corners with a new or unmatched line still
+  /// correct (slam/README.md, departure 11).
+  bool correct_corners_of_matched_lines = false;
   /// MAX of the paper's Algorithm 2: the most features used per correction by
   /// the selective filter (>= 1). Ignored by the classical filter.
   int max_updates = 2;
@@ -125,6 +141,7 @@ struct EkfParams {
     a->Visit(MJSLAM_NVP(control_point_offset_m));
     a->Visit(MJSLAM_NVP(command_noise));
     a->Visit(MJSLAM_NVP(odometry_noise));
+    a->Visit(MJSLAM_NVP(lateral_slip_std_m_per_rad));
     a->Visit(MJSLAM_NVP(initial_position_std_m));
     a->Visit(MJSLAM_NVP(initial_heading_std_rad));
     a->Visit(MJSLAM_NVP(extra_line_rho_std_m));
@@ -133,6 +150,7 @@ struct EkfParams {
     a->Visit(MJSLAM_NVP(extra_corner_bearing_std_rad));
     a->Visit(MJSLAM_NVP(gate_probability));
     a->Visit(MJSLAM_NVP(new_feature_probability));
+    a->Visit(MJSLAM_NVP(correct_corners_of_matched_lines));
     a->Visit(MJSLAM_NVP(max_updates));
   }
   /// Every out-of-range field, keys relative to this struct (nested ones as

@@ -53,6 +53,13 @@ void SlamState::Predict(const MotionInput& input, double a_m) {
   Eigen::Matrix3d P_pp_new;
   P_pp_new.noalias() = A * P_pp * A.transpose();
   P_pp_new.noalias() += W * input.covariance * W.transpose();
+  // Sideways slip: variance across the mid-arc heading, position only.
+  if (input.lateral_variance_m2 > 0.0) {
+    const double mid_heading = x_.z() - 0.5 * input.increment.y();  // x_ is already predicted
+    const Eigen::Vector2d across(-std::sin(mid_heading), std::cos(mid_heading));
+    P_pp_new.topLeftCorner<2, 2>().noalias() +=
+        input.lateral_variance_m2 * across * across.transpose();
+  }
   P_.topLeftCorner<3, 3>() = 0.5 * (P_pp_new + P_pp_new.transpose());
 
   // Cross terms P_fp <- P_fp A^T. A is the identity but for (0,2) and (1,2),

@@ -82,8 +82,10 @@ class SlamState {
   int capacity() const { return static_cast<int>(P_.cols()); }
 
   /// Prediction, Eqs. (1)-(2) with Eq. (6): pose <- f(pose, increment),
-  /// P <- A P A^T + W Q W^T with Q = input.covariance, for the control point
-  /// `a_m` ahead of the axle. O(n): only the pose rows and columns change.
+  /// P <- A P A^T + W Q W^T + s^2 n n^T with Q = input.covariance, for the
+  /// control point `a_m` ahead of the axle; s^2 = input.lateral_variance_m2
+  /// and n the unit vector across the mid-arc heading (position rows only).
+  /// O(n): only the pose rows and columns change.
   void Predict(const MotionInput& input, double a_m);
 
   /// Predicted measurement of feature k at the current mean, canonical for

@@ -46,13 +46,14 @@ std::string* SlamRunTest::dir_ = nullptr;
 app::CsvTable* SlamRunTest::table_ = nullptr;
 
 TEST_F(SlamRunTest, PoseErrorsStayNearTwoSigma) {
-  // Regression guard, not yet the target: both filters should keep each
-  // component inside 2 sigma for >= 90 % of the steps. Measured on these
-  // runs (README, "Filter consistency"): classical x 0.93, y 0.95, th 0.61;
-  // selective x 0.76, y 0.96, th 0.79 -- both filters are overconfident in
-  // heading after sharp turns. The bounds below fail for the known faulty
-  // variants (forward-Euler prediction: x 0.46, th 0.40).
-  const double min_fraction[3] = {0.70, 0.70, 0.50};
+  // Issue target: both filters keep each component inside 2 sigma for
+  // >= 90 % of the steps (seeds 1-3 pooled, 1803 steps). Measured (README,
+  // "Filter consistency"): classical 0.99, 1.00, 0.97; selective 1.00, 1.00,
+  // 0.98. Known faulty variants fail it: no lateral slip in the prediction
+  // (classical heading 0.72, selective 0.76), forward-Euler prediction
+  // (x 0.46, heading 0.40). Corners that correct on top of their lines pass
+  // closer to the bound (classical heading 0.93, selective x 0.92).
+  const double min_fraction[3] = {0.90, 0.90, 0.90};
   for (const std::string f : {"classical", "selective"}) {
     int inside[3] = {0, 0, 0};
     const std::size_t n = table_->rows.size();
@@ -89,20 +90,24 @@ TEST_F(SlamRunTest, PoseCovarianceIsSymmetricPositiveSemiDefinite) {
 }
 
 TEST_F(SlamRunTest, SelectiveUsesAtMostMaxObservationsClassicalUsesAll) {
+  // Matched corners whose two lines matched too correct neither filter
+  // (slam.ekf.correct_corners_of_matched_lines), so nupdated <= nmatched.
   int selective_limited = 0;
   int classical_updates = 0;
+  int selective_updates = 0;
   for (std::size_t r = 0; r < table_->rows.size(); ++r) {
     const double matched = Value(r, "selective_nmatched");
     const double updated = Value(r, "selective_nupdated");
-    ASSERT_LE(updated, 2.0) << "row " << r + 1;
-    ASSERT_EQ(updated, std::min(matched, 2.0)) << "row " << r + 1;
-    if (matched > 2.0) ++selective_limited;
-    ASSERT_EQ(Value(r, "classical_nupdated"), Value(r, "classical_nmatched")) << "row " << r + 1;
+    ASSERT_LE(updated, std::min(matched, 2.0)) << "row " << r + 1;
+    if (updated == 2.0 && matched > 2.0) ++selective_limited;
+    ASSERT_LE(Value(r, "classical_nupdated"), Value(r, "classical_nmatched")) << "row " << r + 1;
     classical_updates += static_cast<int>(Value(r, "classical_nupdated"));
+    selective_updates += static_cast<int>(updated);
   }
   // The run must exercise the selection, or the test above proves nothing.
   EXPECT_GT(selective_limited, 50);
   EXPECT_GT(classical_updates, 500);
+  EXPECT_GT(classical_updates, 2 * selective_updates);
   EXPECT_GT(Value(table_->rows.size() - 1, "classical_nfeat"), 10.0);
 }
 

@@ -226,6 +226,44 @@ TEST(EkfSlamTest, FirstScanAddsFeaturesAndTheSecondMatchesThem) {
   }
 }
 
+TEST(EkfSlamTest, CornerOfTwoMatchedLinesDoesNotCorrectTwice) {
+  // Two walls meeting at (2, 1.5) and their corner. On the second look both
+  // lines match, so the corner adds nothing new: it is matched but left out
+  // of the correction, unless the config asks for it.
+  for (const bool correct_anyway : {false, true}) {
+    EkfParams params;
+    params.correct_corners_of_matched_lines = correct_anyway;
+    EkfSlam filter(params, CorrectionMode::kClassical, Pose2(), Pose2());
+    ScanFeatures features;
+    features.lines.push_back(Line(2.0, 0.0, {2.0, -1.0}, {2.0, 1.5}));
+    features.lines.push_back(Line(1.5, kPi / 2.0, {0.0, 1.5}, {2.0, 1.5}));
+    CornerObservation corner = Corner(std::hypot(2.0, 1.5), std::atan2(1.5, 2.0));
+    corner.line_a = 0;
+    corner.line_b = 1;
+    features.corners.push_back(corner);
+    filter.Step(Still(), &features);
+    const StepReport report = filter.Step(Still(), &features);
+    EXPECT_EQ(report.num_matched, 3);
+    EXPECT_EQ(report.num_redundant_corners, correct_anyway ? 0 : 1);
+    EXPECT_EQ(report.num_updated, correct_anyway ? 3 : 2);
+  }
+  // A corner whose line is new this time still corrects.
+  EkfSlam filter(EkfParams(), CorrectionMode::kClassical, Pose2(), Pose2());
+  ScanFeatures first;
+  first.lines.push_back(Line(2.0, 0.0, {2.0, -1.0}, {2.0, 1.5}));
+  CornerObservation corner = Corner(std::hypot(2.0, 1.5), std::atan2(1.5, 2.0));
+  corner.line_a = 0;
+  first.corners.push_back(corner);
+  filter.Step(Still(), &first);
+  ScanFeatures second = first;
+  second.lines.push_back(Line(1.5, kPi / 2.0, {0.0, 1.5}, {2.0, 1.5}));
+  second.corners[0].line_b = 1;
+  const StepReport report = filter.Step(Still(), &second);
+  EXPECT_EQ(report.num_new, 1);
+  EXPECT_EQ(report.num_redundant_corners, 0);
+  EXPECT_EQ(report.num_updated, 2);
+}
+
 TEST(EkfSlamTest, GatesByMahalanobisDistanceWithADuplicateGuard) {
   // Known pose, no motion: S_rho = 2 kRhoStd^2 for the second look at the
   // wall, so d2 = (offset / kRhoStd)^2 / 2. Gate 9.21 (99 %), new-feature

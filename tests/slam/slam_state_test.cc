@@ -99,6 +99,29 @@ TEST(SlamStateTest, PredictionEqualsDenseAPAtPlusWQWt) {
   EXPECT_LT((state.pose() - PredictPose(x.head<3>(), input.increment, kA)).norm(), 1e-15);
 }
 
+TEST(SlamStateTest, LateralSlipAddsVarianceAcrossTheMidArcHeadingOnly) {
+  Rng rng(23);
+  SlamState with_slip = MakeState(&rng, 4);
+  SlamState without = with_slip;
+  const double th0 = with_slip.pose().z();
+  MotionInput input;
+  input.increment = Eigen::Vector2d(0.05, 0.3);
+  input.covariance << 4e-4, 0.0, 0.0, 9e-4;
+  without.Predict(input, kA);
+  input.lateral_variance_m2 = 2.5e-5;
+  with_slip.Predict(input, kA);
+
+  // The difference is s^2 n n^T in the position block, n across th0 + 0.15.
+  const Eigen::Vector2d n(-std::sin(th0 + 0.15), std::cos(th0 + 0.15));
+  const Eigen::MatrixXd difference = with_slip.covariance() - without.covariance();
+  EXPECT_LT((difference.topLeftCorner<2, 2>() - 2.5e-5 * n * n.transpose()).cwiseAbs().maxCoeff(),
+            1e-15);
+  Eigen::MatrixXd rest = difference;
+  rest.topLeftCorner<2, 2>().setZero();
+  EXPECT_EQ(rest.cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_EQ((with_slip.mean() - without.mean()).cwiseAbs().maxCoeff(), 0.0);
+}
+
 TEST(SlamStateTest, AugmentationEqualsDenseComputation) {
   Rng rng(22);
   for (const FeatureType type : {FeatureType::kLine, FeatureType::kCorner}) {
