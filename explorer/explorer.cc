@@ -39,6 +39,12 @@ const ExplorerParams& Validated(const ExplorerParams& params, double a_m) {
 constexpr double kPathCheckSkipM = 0.3;
 // Path points farther along than this are not checked against the scan, m.
 constexpr double kPathCheckRangeM = 3.0;
+// After the safety layer has held the robot still this long, it backs up
+// (when that is safe) for kRecoveryS at kRecoverySpeedMps, so that it can
+// turn again: seconds, seconds, m/s.
+constexpr double kRecoveryAfterS = 1.0;
+constexpr double kRecoveryS = 1.5;
+constexpr double kRecoverySpeedMps = 0.1;
 
 }  // namespace
 
@@ -55,17 +61,24 @@ std::optional<Eigen::Vector2d> Explorer::goal() const {
   return goal_W_;
 }
 
-bool Explorer::Blacklisted(const Eigen::Vector2d& p_W) const {
-  for (const Eigen::Vector2d& b : blacklist_) {
-    if ((b - p_W).norm() < params_.blacklist_radius_m) return true;
+bool Explorer::Blacklisted(const Eigen::Vector2d& p_W, bool* failed) const {
+  bool near = false;
+  if (failed != nullptr) *failed = false;
+  for (size_t i = 0; i < blacklist_.size(); ++i) {
+    if ((blacklist_[i] - p_W).norm() < params_.blacklist_radius_m) {
+      near = true;
+      if (failed != nullptr && blacklist_failed_[i]) *failed = true;
+    }
   }
-  return false;
+  return near;
 }
 
-void Explorer::DropGoal(bool blacklist) {
+void Explorer::DropGoal(bool blacklist, bool failed) {
   if (has_goal_ && blacklist) {
     blacklist_.push_back(frontier_W_);
     blacklist_.push_back(goal_W_);
+    blacklist_failed_.push_back(failed ? 1 : 0);
+    blacklist_failed_.push_back(failed ? 1 : 0);
   }
   has_goal_ = false;
   tracker_.Clear();
@@ -120,14 +133,20 @@ void Explorer::ChooseGoal(const Pose2& X_WR, double t_s) {
   };
   // Scores frontier points: gain against the cost of the best reachable cell
   // within view distance (cost plus twice its distance to the point).
-  bool any_with_gain = false;
+  // `unreachable` records a frontier with gain that failed or has no
+  // reachable cell (a frontier only near reached goals does not count: the
+  // robot went there and could not see more).
+  bool unreachable = false;
   auto evaluate = [&](const std::vector<Eigen::Vector2d>& points) {
     std::vector<Candidate> candidates;
     for (const Eigen::Vector2d& p : points) {
       const double gain = InformationGain(grid_, p, params_.gain_radius_m);
       if (gain < params_.min_gain_m2) continue;
-      any_with_gain = true;
-      if (Blacklisted(p)) continue;
+      bool failed = false;
+      if (Blacklisted(p, &failed)) {
+        unreachable = unreachable || failed;
+        continue;
+      }
       frontier_points_.push_back(p);
       const Eigen::Vector2i c = grid_.CellOf(p);
       double best = std::numeric_limits<double>::infinity();
@@ -145,7 +164,14 @@ void Explorer::ChooseGoal(const Pose2& X_WR, double t_s) {
           }
         }
       }
-      if (!std::isfinite(best) || Blacklisted(best_W)) continue;
+      if (!std::isfinite(best)) {
+        unreachable = true;
+        continue;
+      }
+      if (Blacklisted(best_W, &failed)) {
+        unreachable = unreachable || failed;
+        continue;
+      }
       candidates.push_back({p, best_W, params_.gain_weight_per_m2 * gain - best});
     }
     std::stable_sort(candidates.begin(), candidates.end(),
@@ -164,7 +190,7 @@ void Explorer::ChooseGoal(const Pose2& X_WR, double t_s) {
     if (PlanToGoal(map, X_WR, t_s)) {
       best_remaining_m_ = RemainingPath(X_WR);
       progress_t_s_ = t_s;
-      blocked_s_ = 0.0;
+      blocked_total_s_ = 0.0;
       return;
     }
     DropGoal(true);
@@ -173,7 +199,7 @@ void Explorer::ChooseGoal(const Pose2& X_WR, double t_s) {
   has_goal_ = false;
   finished_ = true;
   phase_ = Phase::kFinished;
-  finish_reason_ = any_with_gain ? "unreachable" : "no_frontier";
+  finish_reason_ = unreachable ? "unreachable" : "no_frontier";
   tracker_.Clear();
 }
 
@@ -212,7 +238,7 @@ ExplorerOutput Explorer::Step(const Pose2& X_WR, const LaserScan* scan, const Po
   }
   if (phase_ == Phase::kExploring) {
     // Goal bookkeeping: reached, explored meanwhile, failed.
-    if (has_goal_ && tracker_.done()) DropGoal(true);
+    if (has_goal_ && tracker_.done()) DropGoal(true, false);
     if (has_goal_ && scan != nullptr &&
         InformationGain(grid_, frontier_W_, params_.gain_radius_m) < params_.min_gain_m2) {
       DropGoal(false);
@@ -224,7 +250,7 @@ ExplorerOutput Explorer::Step(const Pose2& X_WR, const LaserScan* scan, const Po
         progress_t_s_ = t_s;
       }
       if (t_s - progress_t_s_ > params_.progress_timeout_s ||
-          blocked_s_ > params_.blocked_timeout_s) {
+          blocked_total_s_ > params_.blocked_timeout_s) {
         DropGoal(true);
       }
     }
@@ -267,12 +293,31 @@ ExplorerOutput Explorer::Step(const Pose2& X_WR, const LaserScan* scan, const Po
     return output;
   }
   // Safety layer last: it may brake harder than the acceleration limits.
+  const std::vector<Eigen::Vector2d> obstacles = NearbyObstacles(X_WR);
   bool limited = false;
-  command = SafetyFilter(command, X_WR, NearbyObstacles(X_WR), params_, a_m_, dt_s, &limited);
+  if (blocked_s_ >= kRecoveryAfterS && recovery_until_s_ < t_s) {
+    recovery_until_s_ = t_s + kRecoveryS;
+    blocked_s_ = 0.0;
+  }
+  if (recovery_until_s_ >= t_s) {
+    // Recovery: back up straight while it is safe (the occupied cells of the
+    // grid cover the space behind the laser).
+    const Twist2 back{-kRecoverySpeedMps, 0.0};
+    bool back_limited = false;
+    const Twist2 safe_back = SafetyFilter(back, X_WR, obstacles, params_, a_m_, dt_s,
+                                          &back_limited);
+    if (!back_limited) {
+      command = safe_back;
+    } else {
+      recovery_until_s_ = -1.0;
+    }
+  }
+  command = SafetyFilter(command, X_WR, obstacles, params_, a_m_, dt_s, &limited);
   tracker_.set_last_command(command);
   output.safety_active = limited;
   if (limited && std::abs(command.v_mps) < 1e-3 && std::abs(command.w_radps) < 1e-3) {
     blocked_s_ += dt_s;
+    blocked_total_s_ += dt_s;
   } else {
     blocked_s_ = 0.0;
   }

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -74,7 +75,7 @@ class Explorer {
 
   /// The occupancy grid built so far.
   const OccupancyGrid& grid() const { return grid_; }
-  /// Goals that failed or were reached, in W.
+  /// Frontier points and goals that failed or were reached, in W.
   const std::vector<Eigen::Vector2d>& blacklist() const { return blacklist_; }
   bool finished() const { return finished_; }
   const std::string& finish_reason() const { return finish_reason_; }
@@ -86,9 +87,12 @@ class Explorer {
   void ChooseGoal(const Pose2& X_WR, double t_s);
   // Plans a path to the current goal; false when there is none.
   bool PlanToGoal(const NavigationMap& map, const Pose2& X_WR, double t_s);
-  // Blacklists the current goal and drops it.
-  void DropGoal(bool blacklist);
-  bool Blacklisted(const Eigen::Vector2d& p_W) const;
+  // Drops the current goal; blacklists it when `blacklist`, as failed when
+  // `failed` (otherwise as reached).
+  void DropGoal(bool blacklist, bool failed = true);
+  // Whether a point is near a blacklisted one; `failed` (optional) tells
+  // whether one of those failed.
+  bool Blacklisted(const Eigen::Vector2d& p_W, bool* failed = nullptr) const;
   // Obstacle points near h: the last scan's echoes and occupied cells.
   std::vector<Eigen::Vector2d> NearbyObstacles(const Pose2& X_WR) const;
   // Remaining length of the path from h, metres.
@@ -104,6 +108,8 @@ class Explorer {
   std::vector<Eigen::Vector2d> scan_points_W_;
   std::vector<Eigen::Vector2d> frontier_points_;
   std::vector<Eigen::Vector2d> blacklist_;
+  // Per blacklist entry: 1 when the goal failed, 0 when it was reached.
+  std::vector<std::uint8_t> blacklist_failed_;
 
   bool has_goal_ = false;
   // The frontier point the goal serves, and the cell h drives to.
@@ -112,7 +118,12 @@ class Explorer {
   double last_plan_t_s_ = 0.0;
   double best_remaining_m_ = 0.0;
   double progress_t_s_ = 0.0;
+  // Time the safety layer has held the robot still: in a row (triggers a
+  // recovery) and in all since the goal was chosen (fails the goal).
   double blocked_s_ = 0.0;
+  double blocked_total_s_ = 0.0;
+  // End of the current back-up recovery, seconds (< t when none).
+  double recovery_until_s_ = -1.0;
 
   double turned_rad_ = 0.0;
   double last_theta_ = 0.0;

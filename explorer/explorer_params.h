@@ -41,9 +41,9 @@ struct ExplorerParams {
   // --- Planning ---
   /// Smallest distance between a planned path of h and an occupied cell,
   /// metres.
-  double clearance_m = 0.40;
+  double clearance_m = 0.50;
   /// Paths with less clearance than this pay extra cost, metres.
-  double preferred_clearance_m = 0.8;
+  double preferred_clearance_m = 0.9;
   /// Weight of that extra cost: a step at zero clearance costs (1 + weight)
   /// times its length.
   double clearance_cost_weight = 3.0;

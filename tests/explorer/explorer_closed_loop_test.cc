@@ -4,11 +4,14 @@
 // a reason. Exact scans and the true pose: the explorer alone is under test.
 
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
 
+#include "common/angles.h"
 #include "explorer/explorer.h"
 #include "tests/explorer/kinematic_sim.h"
 
@@ -107,15 +110,33 @@ EpisodeResult RunEpisode(const Pose2& X_WR0, double duration_s) {
   return result;
 }
 
+// From several start poses (one facing a wall 0.6 m ahead, one in the far
+// room facing the column): explored >= 95 %, no contact, a reason, within
+// 10 minutes of simulated time.
 TEST(ExplorerClosedLoopTest, ExploresTwoRoomsWithoutContact) {
-  const EpisodeResult result = RunEpisode(Pose2(1.5, 1.0, 0.3), 600.0);
-  std::printf("finished %d (%s) at t = %.1f s, explored %.3f, distance %.1f m, contacts %d\n",
-              result.finished, result.reason.c_str(), result.t_s, result.explored,
-              result.distance_m, result.contacts);
-  EXPECT_TRUE(result.finished);
-  EXPECT_FALSE(result.reason.empty());
-  EXPECT_GE(result.explored, 0.95);
-  EXPECT_EQ(result.contacts, 0);
+  const Pose2 starts[] = {Pose2(1.5, 1.0, 0.3), Pose2(4.0, 2.0, 0.0),
+                          Pose2(9.0, 0.8, kPi), Pose2(6.2, 2.5, -0.5)};
+  for (const Pose2& start : starts) {
+    const EpisodeResult result = RunEpisode(start, 600.0);
+    std::printf("start (%.1f, %.1f, %.2f): finished %d (%s) at t = %.1f s, explored %.3f, "
+                "distance %.1f m, contacts %d\n",
+                start.x, start.y, start.theta, result.finished, result.reason.c_str(),
+                result.t_s, result.explored, result.distance_m, result.contacts);
+    EXPECT_TRUE(result.finished);
+    EXPECT_EQ(result.reason, "no_frontier");
+    EXPECT_GE(result.explored, 0.95);
+    EXPECT_EQ(result.contacts, 0);
+  }
+}
+
+// Same inputs, same commands, bit for bit.
+TEST(ExplorerClosedLoopTest, EpisodeIsDeterministic) {
+  const EpisodeResult first = RunEpisode(Pose2(1.5, 1.0, 0.3), 30.0);
+  const EpisodeResult second = RunEpisode(Pose2(1.5, 1.0, 0.3), 30.0);
+  ASSERT_EQ(first.commands.size(), second.commands.size());
+  for (size_t i = 0; i < first.commands.size(); ++i) {
+    ASSERT_EQ(first.commands[i], second.commands[i]) << "command value " << i;
+  }
 }
 
 }  // namespace

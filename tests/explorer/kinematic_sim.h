@@ -78,7 +78,7 @@ class KinematicSim {
     Pose2 X_RS = Pose2(-0.1, 0.0, 0.0);
     int num_beams = 181;
     double fov_deg = 180.0;
-    double max_range_m = 8.0;
+    double max_range_m = 4.0;
   };
 
   KinematicSim(std::vector<Wall> walls, const Pose2& X_WR0, const Config& config)
