@@ -1,0 +1,328 @@
+#include "explorer/explorer.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "common/angles.h"
+#include "explorer/frontiers.h"
+#include "explorer/point_h_controller.h"
+
+namespace mjslam::explorer {
+namespace {
+
+OccupancyGridSettings GridSettings(const ExplorerParams& p) {
+  OccupancyGridSettings s;
+  s.resolution_m = p.grid_resolution_m;
+  s.max_insert_range_m = p.max_insert_range_m;
+  s.no_return_free_range_m = p.no_return_free_range_m;
+  s.log_odds_hit = p.log_odds_hit;
+  s.log_odds_miss = p.log_odds_miss;
+  s.log_odds_min = p.log_odds_min;
+  s.log_odds_max = p.log_odds_max;
+  s.occupied_threshold = p.occupied_threshold;
+  s.free_threshold = p.free_threshold;
+  return s;
+}
+
+const ExplorerParams& Validated(const ExplorerParams& params, double a_m) {
+  params.ValidateOrThrow();
+  if (!(a_m > 0.0)) {
+    throw ParamError("robot.control_point_offset_m: expected a value > 0 (got " +
+                     ValueText(a_m) + ")");
+  }
+  return params;
+}
+
+// Path points closer than this to h are not checked against the scan (the
+// robot is already there), metres.
+constexpr double kPathCheckSkipM = 0.3;
+// Path points farther along than this are not checked against the scan, m.
+constexpr double kPathCheckRangeM = 3.0;
+// After the safety layer has held the robot still this long, it backs up
+// (when that is safe) for kRecoveryS at kRecoverySpeedMps, so that it can
+// turn again: seconds, seconds, m/s.
+constexpr double kRecoveryAfterS = 1.0;
+constexpr double kRecoveryS = 1.5;
+constexpr double kRecoverySpeedMps = 0.1;
+
+}  // namespace
+
+Explorer::Explorer(const ExplorerParams& params, double a_m)
+    : params_(Validated(params, a_m)),
+      a_m_(a_m),
+      grid_(GridSettings(params)),
+      tracker_(params, a_m) {
+  if (params_.initial_turn_deg <= 0.0) phase_ = Phase::kExploring;
+}
+
+std::optional<Eigen::Vector2d> Explorer::goal() const {
+  if (!has_goal_) return std::nullopt;
+  return goal_W_;
+}
+
+bool Explorer::Blacklisted(const Eigen::Vector2d& p_W, bool* failed) const {
+  bool near = false;
+  if (failed != nullptr) *failed = false;
+  for (size_t i = 0; i < blacklist_.size(); ++i) {
+    if ((blacklist_[i] - p_W).norm() < params_.blacklist_radius_m) {
+      near = true;
+      if (failed != nullptr && blacklist_failed_[i]) *failed = true;
+    }
+  }
+  return near;
+}
+
+void Explorer::DropGoal(bool blacklist, bool failed) {
+  if (has_goal_ && blacklist) {
+    blacklist_.push_back(frontier_W_);
+    blacklist_.push_back(goal_W_);
+    blacklist_failed_.push_back(failed ? 1 : 0);
+    blacklist_failed_.push_back(failed ? 1 : 0);
+  }
+  has_goal_ = false;
+  tracker_.Clear();
+  ++log_version_;
+}
+
+std::vector<Eigen::Vector2d> Explorer::NearbyObstacles(const Pose2& X_WR) const {
+  std::vector<Eigen::Vector2d> points;
+  const Eigen::Vector2d h = X_WR.translation();
+  const double range = params_.safety_range_m;
+  for (const Eigen::Vector2d& p : scan_points_W_) {
+    if ((p - h).norm() < range) points.push_back(p);
+  }
+  // Occupied cells cover what the laser does not see (behind the robot).
+  const Eigen::Vector2i lo = grid_.CellOf(h.array() - range);
+  const Eigen::Vector2i hi = grid_.CellOf(h.array() + range);
+  for (int iy = std::max(0, lo.y()); iy <= std::min(grid_.height() - 1, hi.y()); ++iy) {
+    for (int ix = std::max(0, lo.x()); ix <= std::min(grid_.width() - 1, hi.x()); ++ix) {
+      if (grid_.State(ix, iy) != CellState::kOccupied) continue;
+      const Eigen::Vector2d c = grid_.CellCenter(ix, iy);
+      if ((c - h).norm() < range) points.push_back(c);
+    }
+  }
+  return points;
+}
+
+double Explorer::RemainingPath(const Pose2& X_WR) const {
+  const Path& path = tracker_.path();
+  if (path.empty()) return 0.0;
+  const PathPoint& near = path[tracker_.index()];
+  return path.back().s_m - near.s_m + (near.p_W - X_WR.translation()).norm();
+}
+
+bool Explorer::PlanToGoal(const NavigationMap& map, const Pose2& X_WR, double t_s) {
+  Path path = PlanPath(map, params_, goal_W_, X_WR.theta);
+  last_plan_t_s_ = t_s;
+  if (path.empty()) return false;
+  tracker_.SetPath(std::move(path));
+  ++log_version_;
+  return true;
+}
+
+void Explorer::ChooseGoal(const Pose2& X_WR, double t_s) {
+  const NavigationMap map(grid_, params_, X_WR.translation());
+  const double r = grid_.resolution();
+  const int window = static_cast<int>(std::ceil(params_.view_distance_m / r));
+
+  struct Candidate {
+    Eigen::Vector2d frontier_W;
+    Eigen::Vector2d goal_W;
+    double score;
+  };
+  // Scores frontier points: gain against the cost of the best reachable cell
+  // within view distance (cost plus twice its distance to the point).
+  // `unreachable` records a frontier with gain that failed or has no
+  // reachable cell (a frontier only near reached goals does not count: the
+  // robot went there and could not see more).
+  bool unreachable = false;
+  auto evaluate = [&](const std::vector<Eigen::Vector2d>& points) {
+    std::vector<Candidate> candidates;
+    for (const Eigen::Vector2d& p : points) {
+      const double gain = InformationGain(grid_, p, params_.gain_radius_m);
+      if (gain < params_.min_gain_m2) continue;
+      bool failed = false;
+      if (Blacklisted(p, &failed)) {
+        unreachable = unreachable || failed;
+        continue;
+      }
+      frontier_points_.push_back(p);
+      const Eigen::Vector2i c = grid_.CellOf(p);
+      double best = std::numeric_limits<double>::infinity();
+      Eigen::Vector2d best_W = p;
+      for (int iy = c.y() - window; iy <= c.y() + window; ++iy) {
+        for (int ix = c.x() - window; ix <= c.x() + window; ++ix) {
+          const double cost = map.CostTo(ix, iy);
+          if (!std::isfinite(cost)) continue;
+          const Eigen::Vector2d cell = grid_.CellCenter(ix, iy);
+          const double distance = (cell - p).norm();
+          if (distance > params_.view_distance_m) continue;
+          if (cost + 2.0 * distance < best) {
+            best = cost + 2.0 * distance;
+            best_W = cell;
+          }
+        }
+      }
+      if (!std::isfinite(best)) {
+        unreachable = true;
+        continue;
+      }
+      if (Blacklisted(best_W, &failed)) {
+        unreachable = unreachable || failed;
+        continue;
+      }
+      candidates.push_back({p, best_W, params_.gain_weight_per_m2 * gain - best});
+    }
+    std::stable_sort(candidates.begin(), candidates.end(),
+                     [](const Candidate& a, const Candidate& b) { return a.score > b.score; });
+    return candidates;
+  };
+
+  frontier_points_.clear();
+  ++log_version_;
+  std::vector<Candidate> candidates = evaluate(local_points_);
+  if (candidates.empty()) candidates = evaluate(GlobalFrontierPoints(grid_, params_));
+  for (const Candidate& candidate : candidates) {
+    frontier_W_ = candidate.frontier_W;
+    goal_W_ = candidate.goal_W;
+    has_goal_ = true;
+    if (PlanToGoal(map, X_WR, t_s)) {
+      best_remaining_m_ = RemainingPath(X_WR);
+      progress_t_s_ = t_s;
+      blocked_total_s_ = 0.0;
+      return;
+    }
+    DropGoal(true);
+  }
+  // Nothing left to explore or to reach.
+  has_goal_ = false;
+  finished_ = true;
+  phase_ = Phase::kFinished;
+  finish_reason_ = unreachable ? "unreachable" : "no_frontier";
+  tracker_.Clear();
+}
+
+ExplorerOutput Explorer::Step(const Pose2& X_WR, const LaserScan* scan, const Pose2& X_RS,
+                              double t_s, double dt_s) {
+  ExplorerOutput output;
+  // The map and the scan's frontier points.
+  if (scan != nullptr) {
+    const Pose2 X_WS = X_WR * X_RS;
+    grid_.InsertScan(*scan, X_WS);
+    grid_.MarkRectangleFree(X_WR, params_.body_rear_x_m, params_.body_front_x_m,
+                            params_.body_half_width_m);
+    local_points_ = LocalFrontierPoints(*scan, X_WS, params_);
+    scan_points_W_.clear();
+    for (int i = 0; i < scan->size(); ++i) {
+      if (scan->has_return[i] == 0 || scan->ranges_m[i] >= scan->max_range_m) continue;
+      const double th = X_WS.theta + scan->BeamAngle(i);
+      scan_points_W_.push_back(X_WS.translation() +
+                               scan->ranges_m[i] * Eigen::Vector2d(std::cos(th), std::sin(th)));
+    }
+  }
+
+  Twist2 command;
+  if (phase_ == Phase::kInitialTurn) {
+    // Look around first: the laser covers only the half-plane ahead.
+    if (have_last_theta_) turned_rad_ += std::abs(WrapAngle(X_WR.theta - last_theta_));
+    have_last_theta_ = true;
+    last_theta_ = X_WR.theta;
+    if (turned_rad_ >= DegToRad(params_.initial_turn_deg)) {
+      phase_ = Phase::kExploring;
+    } else {
+      const Twist2 target{0.0, 0.5 * params_.max_angular_speed_radps};
+      command = RateLimit(tracker_.last_command(), target, params_.max_linear_accel_mps2 * dt_s,
+                          params_.max_angular_accel_radps2 * dt_s);
+    }
+  }
+  if (phase_ == Phase::kExploring) {
+    // Goal bookkeeping: reached, explored meanwhile, failed.
+    if (has_goal_ && tracker_.done()) DropGoal(true, false);
+    if (has_goal_ && scan != nullptr &&
+        InformationGain(grid_, frontier_W_, params_.gain_radius_m) < params_.min_gain_m2) {
+      DropGoal(false);
+    }
+    if (has_goal_) {
+      const double remaining = RemainingPath(X_WR);
+      if (remaining < best_remaining_m_ - params_.progress_min_m) {
+        best_remaining_m_ = remaining;
+        progress_t_s_ = t_s;
+      }
+      if (t_s - progress_t_s_ > params_.progress_timeout_s ||
+          blocked_total_s_ > params_.blocked_timeout_s) {
+        DropGoal(true);
+      }
+    }
+    if (!has_goal_) {
+      ChooseGoal(X_WR, t_s);
+    } else {
+      // Replan periodically and when the current scan blocks the path ahead.
+      bool blocked_path = false;
+      const Path& path = tracker_.path();
+      const double s0 = path.empty() ? 0.0 : path[tracker_.index()].s_m;
+      for (int i = tracker_.index(); i < static_cast<int>(path.size()) && !blocked_path; ++i) {
+        if (path[i].s_m - s0 < kPathCheckSkipM) continue;
+        if (path[i].s_m - s0 > kPathCheckRangeM) break;
+        for (const Eigen::Vector2d& q : scan_points_W_) {
+          if ((q - path[i].p_W).norm() < params_.body_half_width_m + params_.safety_margin_m) {
+            blocked_path = true;
+            break;
+          }
+        }
+      }
+      if (blocked_path || t_s - last_plan_t_s_ >= params_.replan_period_s) {
+        const NavigationMap map(grid_, params_, X_WR.translation());
+        const double remaining_before = best_remaining_m_;
+        if (PlanToGoal(map, X_WR, t_s)) {
+          // Keep the progress clock: a new plan is not progress.
+          best_remaining_m_ = std::min(remaining_before, RemainingPath(X_WR));
+        } else {
+          DropGoal(true);
+          ChooseGoal(X_WR, t_s);
+        }
+      }
+    }
+    if (!finished_) command = tracker_.Command(X_WR, dt_s);
+  }
+
+  if (finished_) {
+    output.finished = true;
+    output.finish_reason = finish_reason_;
+    output.command = Twist2{};
+    return output;
+  }
+  // Safety layer last: it may brake harder than the acceleration limits.
+  const std::vector<Eigen::Vector2d> obstacles = NearbyObstacles(X_WR);
+  bool limited = false;
+  if (blocked_s_ >= kRecoveryAfterS && recovery_until_s_ < t_s) {
+    recovery_until_s_ = t_s + kRecoveryS;
+    blocked_s_ = 0.0;
+  }
+  if (recovery_until_s_ >= t_s) {
+    // Recovery: back up straight while it is safe (the occupied cells of the
+    // grid cover the space behind the laser).
+    const Twist2 back{-kRecoverySpeedMps, 0.0};
+    bool back_limited = false;
+    const Twist2 safe_back = SafetyFilter(back, X_WR, obstacles, params_, a_m_, dt_s,
+                                          &back_limited);
+    if (!back_limited) {
+      command = safe_back;
+    } else {
+      recovery_until_s_ = -1.0;
+    }
+  }
+  command = SafetyFilter(command, X_WR, obstacles, params_, a_m_, dt_s, &limited);
+  tracker_.set_last_command(command);
+  output.safety_active = limited;
+  if (limited && std::abs(command.v_mps) < 1e-3 && std::abs(command.w_radps) < 1e-3) {
+    blocked_s_ += dt_s;
+    blocked_total_s_ += dt_s;
+  } else {
+    blocked_s_ = 0.0;
+  }
+  output.command = command;
+  return output;
+}
+
+}  // namespace mjslam::explorer

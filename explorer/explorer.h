@@ -1,0 +1,137 @@
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "common/laser_scan.h"
+#include "common/pose2.h"
+#include "common/records.h"
+#include "explorer/explorer_params.h"
+#include "explorer/occupancy_grid.h"
+#include "explorer/path_planner.h"
+#include "explorer/path_tracker.h"
+
+namespace mjslam::explorer {
+
+/// What the explorer decided at one control step.
+struct ExplorerOutput {
+  /// Command for R to hold during the next `dt_s`.
+  Twist2 command;
+  /// True once exploration has ended (the command is then zero for good).
+  bool finished = false;
+  /// Why it ended: "no_frontier" (no unexplored frontier is left),
+  /// "unreachable" (frontiers are left but none can be reached or all of
+  /// them failed); empty while exploring.
+  std::string finish_reason;
+  /// Whether the safety layer changed the command at this step.
+  bool safety_active = false;
+};
+
+/// The frontier explorer (method.md "The explorer"; the paper's ref. [10]):
+/// the one entry point the application calls at every control step.
+///
+/// At each new scan it updates a log-odds occupancy grid at the estimated
+/// laser pose and computes the scan's local frontier points. Whenever it has
+/// no goal (at the start after an optional turn in place, when the goal is
+/// reached, explored meanwhile, or failed), it scores the local frontier
+/// points (information gain against path cost), or, when none is left, the
+/// grid's global frontier points, and plans a feasible path to the best one;
+/// it replans every `replan_period_s` and when the current scan blocks the
+/// path. A PathTracker drives h along the path and a SafetyFilter keeps the
+/// body off the walls. Goals that fail (unplannable, no progress within
+/// `progress_timeout_s`, blocked by the safety layer for `blocked_timeout_s`)
+/// and goals reached are blacklisted. It stops only when no frontier point
+/// with gain is left ("no_frontier") or none can be reached ("unreachable").
+///
+/// Deterministic: no randomness, no clock; the same inputs give the same
+/// outputs bit for bit.
+class Explorer {
+ public:
+  /// `a_m` > 0: the offset of h ahead of the axle (the robot's
+  /// `control_point_offset_m`), metres. Throws ParamError on invalid params
+  /// (keys prefixed `explorer.`) or on a bad `a_m`.
+  Explorer(const ExplorerParams& params, double a_m);
+
+  /// One control step. `X_WR`: the pose estimate of R (the point h) in W;
+  /// `scan`: a new sweep or nullptr; `X_RS`: the laser mount (pose of S in R);
+  /// `t_s`: time since the start; `dt_s` > 0: how long the command will be
+  /// held (the control period).
+  ExplorerOutput Step(const Pose2& X_WR, const LaserScan* scan, const Pose2& X_RS, double t_s,
+                      double dt_s);
+
+  /// For logging (explorer.csv): the frontier points of the last goal
+  /// choice (kind `frontier`), the current goal (kind `goal`), and the current
+  /// path (kind `path`), in W.
+  const std::vector<Eigen::Vector2d>& frontier_points() const { return frontier_points_; }
+  std::optional<Eigen::Vector2d> goal() const;
+  const Path& path() const { return tracker_.path(); }
+  /// Incremented whenever the frontier points, the goal or the path change:
+  /// write explorer.csv rows when it differs from the last one written.
+  int log_version() const { return log_version_; }
+
+  /// The occupancy grid built so far.
+  const OccupancyGrid& grid() const { return grid_; }
+  /// Frontier points and goals that failed or were reached, in W.
+  const std::vector<Eigen::Vector2d>& blacklist() const { return blacklist_; }
+  bool finished() const { return finished_; }
+  const std::string& finish_reason() const { return finish_reason_; }
+
+ private:
+  enum class Phase { kInitialTurn, kExploring, kFinished };
+
+  // Picks a goal and plans a path to it; finishes when there is none.
+  void ChooseGoal(const Pose2& X_WR, double t_s);
+  // Plans a path to the current goal; false when there is none.
+  bool PlanToGoal(const NavigationMap& map, const Pose2& X_WR, double t_s);
+  // Drops the current goal; blacklists it when `blacklist`, as failed when
+  // `failed` (otherwise as reached).
+  void DropGoal(bool blacklist, bool failed = true);
+  // Whether a point is near a blacklisted one; `failed` (optional) tells
+  // whether one of those failed.
+  bool Blacklisted(const Eigen::Vector2d& p_W, bool* failed = nullptr) const;
+  // Obstacle points near h: the last scan's echoes and occupied cells.
+  std::vector<Eigen::Vector2d> NearbyObstacles(const Pose2& X_WR) const;
+  // Remaining length of the path from h, metres.
+  double RemainingPath(const Pose2& X_WR) const;
+
+  ExplorerParams params_;
+  double a_m_;
+  OccupancyGrid grid_;
+  PathTracker tracker_;
+  Phase phase_ = Phase::kInitialTurn;
+
+  std::vector<Eigen::Vector2d> local_points_;
+  std::vector<Eigen::Vector2d> scan_points_W_;
+  std::vector<Eigen::Vector2d> frontier_points_;
+  std::vector<Eigen::Vector2d> blacklist_;
+  // Per blacklist entry: 1 when the goal failed, 0 when it was reached.
+  std::vector<std::uint8_t> blacklist_failed_;
+
+  bool has_goal_ = false;
+  // The frontier point the goal serves, and the cell h drives to.
+  Eigen::Vector2d frontier_W_ = Eigen::Vector2d::Zero();
+  Eigen::Vector2d goal_W_ = Eigen::Vector2d::Zero();
+  double last_plan_t_s_ = 0.0;
+  double best_remaining_m_ = 0.0;
+  double progress_t_s_ = 0.0;
+  // Time the safety layer has held the robot still: in a row (triggers a
+  // recovery) and in all since the goal was chosen (fails the goal).
+  double blocked_s_ = 0.0;
+  double blocked_total_s_ = 0.0;
+  // End of the current back-up recovery, seconds (< t when none).
+  double recovery_until_s_ = -1.0;
+
+  double turned_rad_ = 0.0;
+  double last_theta_ = 0.0;
+  bool have_last_theta_ = false;
+
+  bool finished_ = false;
+  std::string finish_reason_;
+  int log_version_ = 0;
+};
+
+}  // namespace mjslam::explorer

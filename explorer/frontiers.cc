@@ -1,0 +1,158 @@
+#include "explorer/frontiers.h"
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+
+#include "common/angles.h"
+
+namespace mjslam::explorer {
+namespace {
+
+// Whether a cell stops a gain ray: it or one of its 4-neighbours is occupied.
+bool BlocksRay(const OccupancyGrid& grid, int ix, int iy) {
+  return grid.State(ix, iy) == CellState::kOccupied ||
+         grid.State(ix + 1, iy) == CellState::kOccupied ||
+         grid.State(ix - 1, iy) == CellState::kOccupied ||
+         grid.State(ix, iy + 1) == CellState::kOccupied ||
+         grid.State(ix, iy - 1) == CellState::kOccupied;
+}
+
+}  // namespace
+
+std::vector<Eigen::Vector2d> LocalFrontierPoints(const LaserScan& scan, const Pose2& X_WS,
+                                                 const ExplorerParams& params) {
+  std::vector<Eigen::Vector2d> points;
+  const int n = scan.size();
+  const Eigen::Vector2d p_WS = X_WS.translation();
+  auto open = [&](int i) {
+    return scan.has_return[i] == 0 || scan.ranges_m[i] >= scan.max_range_m ||
+           scan.ranges_m[i] > params.max_insert_range_m;
+  };
+  auto direction = [&](int i) {
+    const double th = X_WS.theta + scan.BeamAngle(i);
+    return Eigen::Vector2d(std::cos(th), std::sin(th));
+  };
+  // Moves a point toward the laser by the standoff (not past the laser).
+  auto pull_back = [&](const Eigen::Vector2d& p) {
+    const Eigen::Vector2d to_laser = p_WS - p;
+    const double d = to_laser.norm();
+    if (d < 1e-9) return p;
+    return Eigen::Vector2d(p + std::min(params.frontier_standoff_m, 0.5 * d) / d * to_laser);
+  };
+
+  // Openings between consecutive echoes.
+  for (int i = 0; i + 1 < n; ++i) {
+    if (open(i) || open(i + 1)) continue;
+    const Eigen::Vector2d a = p_WS + scan.ranges_m[i] * direction(i);
+    const Eigen::Vector2d b = p_WS + scan.ranges_m[i + 1] * direction(i + 1);
+    if ((a - b).norm() >= params.min_opening_m) points.push_back(pull_back(0.5 * (a + b)));
+  }
+  // Runs of open beams.
+  const double free_range = std::min(params.no_return_free_range_m, params.max_insert_range_m);
+  int i = 0;
+  while (i < n) {
+    if (!open(i)) {
+      ++i;
+      continue;
+    }
+    int j = i;
+    while (j + 1 < n && open(j + 1)) ++j;
+    const double width = free_range * std::abs(scan.angle_increment_rad) * (j - i + 1);
+    if (width >= params.min_opening_m) {
+      const int middle = (i + j) / 2;
+      points.push_back(p_WS + std::max(0.0, free_range - params.frontier_standoff_m) *
+                                  direction(middle));
+    }
+    i = j + 1;
+  }
+  return points;
+}
+
+std::vector<Eigen::Vector2d> GlobalFrontierPoints(const OccupancyGrid& grid,
+                                                  const ExplorerParams& params) {
+  const int w = grid.width();
+  const int h = grid.height();
+  std::vector<Eigen::Vector2d> points;
+  if (w == 0) return points;
+  // Frontier cells: free, with an unknown 4-neighbour.
+  std::vector<std::uint8_t> frontier(static_cast<size_t>(w) * h, 0);
+  for (int iy = 0; iy < h; ++iy) {
+    for (int ix = 0; ix < w; ++ix) {
+      if (grid.State(ix, iy) != CellState::kFree) continue;
+      frontier[grid.Index(ix, iy)] = grid.State(ix + 1, iy) == CellState::kUnknown ||
+                                     grid.State(ix - 1, iy) == CellState::kUnknown ||
+                                     grid.State(ix, iy + 1) == CellState::kUnknown ||
+                                     grid.State(ix, iy - 1) == CellState::kUnknown;
+    }
+  }
+  // Clusters (8-connected, breadth first), cut into pieces of about 1 m.
+  const int piece_cells = std::max(1, static_cast<int>(std::lround(1.0 / grid.resolution())));
+  std::vector<std::uint8_t> seen(frontier.size(), 0);
+  for (int start = 0; start < w * h; ++start) {
+    if (!frontier[start] || seen[start]) continue;
+    std::vector<int> cluster;
+    std::deque<int> queue = {start};
+    seen[start] = 1;
+    while (!queue.empty()) {
+      const int c = queue.front();
+      queue.pop_front();
+      cluster.push_back(c);
+      const int cx = c % w;
+      const int cy = c / w;
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int nx = cx + dx;
+          const int ny = cy + dy;
+          if (!grid.Contains(nx, ny)) continue;
+          const int j = grid.Index(nx, ny);
+          if (frontier[j] && !seen[j]) {
+            seen[j] = 1;
+            queue.push_back(j);
+          }
+        }
+      }
+    }
+    if (static_cast<int>(cluster.size()) < params.min_frontier_cells) continue;
+    for (size_t first = 0; first < cluster.size(); first += piece_cells) {
+      const size_t last = std::min(cluster.size(), first + piece_cells);
+      Eigen::Vector2d centroid = Eigen::Vector2d::Zero();
+      for (size_t k = first; k < last; ++k) {
+        centroid += grid.CellCenter(cluster[k] % w, cluster[k] / w);
+      }
+      centroid /= double(last - first);
+      Eigen::Vector2d best = grid.CellCenter(cluster[first] % w, cluster[first] / w);
+      for (size_t k = first; k < last; ++k) {
+        const Eigen::Vector2d p = grid.CellCenter(cluster[k] % w, cluster[k] / w);
+        if ((p - centroid).squaredNorm() < (best - centroid).squaredNorm()) best = p;
+      }
+      points.push_back(best);
+    }
+  }
+  return points;
+}
+
+double InformationGain(const OccupancyGrid& grid, const Eigen::Vector2d& p_W, double radius_m) {
+  const double r = grid.resolution();
+  const int num_rays = std::max(16, static_cast<int>(std::ceil(2.0 * kPi * radius_m / r)));
+  const int steps = static_cast<int>(std::ceil(radius_m / (0.5 * r)));
+  // Count each unknown cell once.
+  std::vector<long long> counted;
+  for (int k = 0; k < num_rays; ++k) {
+    const double th = 2.0 * kPi * k / num_rays;
+    const Eigen::Vector2d u(std::cos(th), std::sin(th));
+    for (int j = 1; j <= steps; ++j) {
+      const Eigen::Vector2i c = grid.CellOf(p_W + (radius_m * j / steps) * u);
+      if (BlocksRay(grid, c.x(), c.y())) break;
+      if (grid.State(c.x(), c.y()) == CellState::kUnknown) {
+        counted.push_back((static_cast<long long>(c.y()) << 32) ^
+                          static_cast<unsigned int>(c.x()));
+      }
+    }
+  }
+  std::sort(counted.begin(), counted.end());
+  const auto unique = std::unique(counted.begin(), counted.end()) - counted.begin();
+  return unique * r * r;
+}
+
+}  // namespace mjslam::explorer

@@ -1,0 +1,213 @@
+#include "explorer/occupancy_grid.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "common/check.h"
+
+namespace mjslam::explorer {
+namespace {
+
+// Margin added around the covered box when the grid grows, metres: growing by
+// chunks keeps the number of reallocations small.
+constexpr double kGrowthMarginM = 2.0;
+
+}  // namespace
+
+OccupancyGrid::OccupancyGrid(const OccupancyGridSettings& settings) : settings_(settings) {
+  MJSLAM_CHECK(settings_.resolution_m > 0.0);
+}
+
+Eigen::Vector2i OccupancyGrid::CellOf(const Eigen::Vector2d& p_W) const {
+  const Eigen::Vector2d q = (p_W - origin_) / settings_.resolution_m;
+  return {static_cast<int>(std::floor(q.x())), static_cast<int>(std::floor(q.y()))};
+}
+
+Eigen::Vector2d OccupancyGrid::CellCenter(int ix, int iy) const {
+  return origin_ + settings_.resolution_m * Eigen::Vector2d(ix + 0.5, iy + 0.5);
+}
+
+double OccupancyGrid::LogOdds(int ix, int iy) const {
+  return Contains(ix, iy) ? log_odds_[Index(ix, iy)] : 0.0;
+}
+
+CellState OccupancyGrid::State(int ix, int iy) const {
+  if (!Contains(ix, iy)) return CellState::kUnknown;
+  const double l = log_odds_[Index(ix, iy)];
+  if (l >= settings_.occupied_threshold) return CellState::kOccupied;
+  if (l <= settings_.free_threshold) return CellState::kFree;
+  return CellState::kUnknown;
+}
+
+CellState OccupancyGrid::StateAt(const Eigen::Vector2d& p_W) const {
+  const Eigen::Vector2i c = CellOf(p_W);
+  return State(c.x(), c.y());
+}
+
+double OccupancyGrid::KnownFreeArea() const {
+  int count = 0;
+  for (int iy = 0; iy < height_; ++iy) {
+    for (int ix = 0; ix < width_; ++ix) count += State(ix, iy) == CellState::kFree;
+  }
+  return count * settings_.resolution_m * settings_.resolution_m;
+}
+
+void OccupancyGrid::EnsureCovers(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi) {
+  const double r = settings_.resolution_m;
+  if (width_ > 0) {
+    const Eigen::Vector2d top = origin_ + r * Eigen::Vector2d(width_, height_);
+    if (lo.x() >= origin_.x() && lo.y() >= origin_.y() && hi.x() < top.x() &&
+        hi.y() < top.y()) {
+      return;
+    }
+  }
+  // New bounds on the existing cell lattice (origin moves by whole cells).
+  Eigen::Vector2d new_lo = lo.array() - kGrowthMarginM;
+  Eigen::Vector2d new_hi = hi.array() + kGrowthMarginM;
+  if (width_ > 0) {
+    new_lo = new_lo.cwiseMin(origin_);
+    new_hi = new_hi.cwiseMax(origin_ + r * Eigen::Vector2d(width_, height_));
+    const Eigen::Vector2d shift =
+        ((origin_ - new_lo) / r).array().ceil().matrix() * r;  // whole cells
+    new_lo = origin_ - shift;
+  } else {
+    new_lo = (new_lo / r).array().floor().matrix() * r;
+  }
+  const int new_width = static_cast<int>(std::ceil((new_hi.x() - new_lo.x()) / r)) + 1;
+  const int new_height = static_cast<int>(std::ceil((new_hi.y() - new_lo.y()) / r)) + 1;
+  std::vector<float> grown(static_cast<size_t>(new_width) * new_height, 0.0f);
+  const int dx = static_cast<int>(std::lround((origin_.x() - new_lo.x()) / r));
+  const int dy = static_cast<int>(std::lround((origin_.y() - new_lo.y()) / r));
+  for (int iy = 0; iy < height_; ++iy) {
+    for (int ix = 0; ix < width_; ++ix) {
+      grown[(iy + dy) * new_width + ix + dx] = log_odds_[Index(ix, iy)];
+    }
+  }
+  log_odds_.swap(grown);
+  origin_ = new_lo;
+  width_ = new_width;
+  height_ = new_height;
+  marks_.assign(log_odds_.size(), 0);
+  touched_.clear();
+}
+
+void OccupancyGrid::MarkRayFree(const Eigen::Vector2d& from, const Eigen::Vector2d& to) {
+  // Samples at half a cell: every cell the ray crosses for more than a
+  // sliver is visited.
+  const double length = (to - from).norm();
+  const int steps = static_cast<int>(std::ceil(length / (0.5 * settings_.resolution_m)));
+  for (int k = 0; k <= steps; ++k) {
+    const Eigen::Vector2d p = from + (steps == 0 ? 0.0 : double(k) / steps) * (to - from);
+    const Eigen::Vector2i c = CellOf(p);
+    if (!Contains(c.x(), c.y())) continue;
+    const int i = Index(c.x(), c.y());
+    if (marks_[i] == 0) {
+      marks_[i] = 1;
+      touched_.push_back(i);
+    }
+  }
+}
+
+void OccupancyGrid::ApplyMarks() {
+  for (const int i : touched_) {
+    const double delta = marks_[i] == 2 ? settings_.log_odds_hit : settings_.log_odds_miss;
+    log_odds_[i] = static_cast<float>(std::clamp(log_odds_[i] + delta, settings_.log_odds_min,
+                                                 settings_.log_odds_max));
+    marks_[i] = 0;
+  }
+  touched_.clear();
+}
+
+void OccupancyGrid::InsertScan(const LaserScan& scan, const Pose2& X_WS) {
+  const int n = scan.size();
+  if (n == 0) return;
+  const double r_cell = settings_.resolution_m;
+  // Range up to which each beam proves free space, and whether it ends on an
+  // echo that is inserted as occupied.
+  std::vector<double> free_range(n);
+  std::vector<std::uint8_t> hit(n);
+  for (int i = 0; i < n; ++i) {
+    const bool echo = scan.has_return[i] != 0 && scan.ranges_m[i] < scan.max_range_m;
+    if (echo && scan.ranges_m[i] <= settings_.max_insert_range_m) {
+      free_range[i] = std::max(0.0, scan.ranges_m[i] - 0.5 * r_cell);
+      hit[i] = 1;
+    } else if (echo) {
+      free_range[i] = settings_.max_insert_range_m;
+      hit[i] = 0;
+    } else {
+      free_range[i] = std::min(settings_.no_return_free_range_m, settings_.max_insert_range_m);
+      hit[i] = 0;
+    }
+  }
+  // Grow the grid to cover every point the scan touches.
+  const Eigen::Vector2d p_WS = X_WS.translation();
+  Eigen::Vector2d lo = p_WS;
+  Eigen::Vector2d hi = p_WS;
+  for (int i = 0; i < n; ++i) {
+    const double th = X_WS.theta + scan.BeamAngle(i);
+    const double range = hit[i] ? scan.ranges_m[i] : free_range[i];
+    const Eigen::Vector2d p = p_WS + range * Eigen::Vector2d(std::cos(th), std::sin(th));
+    lo = lo.cwiseMin(p);
+    hi = hi.cwiseMax(p);
+  }
+  EnsureCovers(lo, hi);
+
+  // Free space along each beam and, with sub-rays, between consecutive beams
+  // up to the shorter of their free ranges.
+  for (int i = 0; i < n; ++i) {
+    const double th = X_WS.theta + scan.BeamAngle(i);
+    MarkRayFree(p_WS, p_WS + free_range[i] * Eigen::Vector2d(std::cos(th), std::sin(th)));
+    if (i + 1 == n) break;
+    const double range = std::min(free_range[i], free_range[i + 1]) - 0.5 * r_cell;
+    if (range <= 0.0) continue;
+    const int sub = static_cast<int>(std::ceil(range * std::abs(scan.angle_increment_rad) /
+                                               (0.7 * r_cell)));
+    for (int k = 1; k < sub; ++k) {
+      const double th_k = th + scan.angle_increment_rad * double(k) / sub;
+      MarkRayFree(p_WS, p_WS + range * Eigen::Vector2d(std::cos(th_k), std::sin(th_k)));
+    }
+  }
+  // Echoes: occupied wins over free within one scan.
+  for (int i = 0; i < n; ++i) {
+    if (!hit[i]) continue;
+    const double th = X_WS.theta + scan.BeamAngle(i);
+    const Eigen::Vector2i c =
+        CellOf(p_WS + scan.ranges_m[i] * Eigen::Vector2d(std::cos(th), std::sin(th)));
+    if (!Contains(c.x(), c.y())) continue;
+    const int index = Index(c.x(), c.y());
+    if (marks_[index] == 0) touched_.push_back(index);
+    marks_[index] = 2;
+  }
+  ApplyMarks();
+}
+
+void OccupancyGrid::MarkRectangleFree(const Pose2& X_WB, double x0_m, double x1_m,
+                                      double half_width_m) {
+  const Pose2 X_BW = X_WB.Inverse();
+  Eigen::Vector2d lo = X_WB.translation();
+  Eigen::Vector2d hi = lo;
+  for (const double x : {x0_m, x1_m}) {
+    for (const double y : {-half_width_m, half_width_m}) {
+      const Eigen::Vector2d p = X_WB * Eigen::Vector2d(x, y);
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+    }
+  }
+  EnsureCovers(lo, hi);
+  const Eigen::Vector2i c0 = CellOf(lo);
+  const Eigen::Vector2i c1 = CellOf(hi);
+  for (int iy = c0.y(); iy <= c1.y(); ++iy) {
+    for (int ix = c0.x(); ix <= c1.x(); ++ix) {
+      const Eigen::Vector2d p_B = X_BW * CellCenter(ix, iy);
+      if (p_B.x() < x0_m || p_B.x() > x1_m || std::abs(p_B.y()) > half_width_m) continue;
+      const int i = Index(ix, iy);
+      if (marks_[i] == 0) {
+        marks_[i] = 1;
+        touched_.push_back(i);
+      }
+    }
+  }
+  ApplyMarks();
+}
+
+}  // namespace mjslam::explorer

@@ -1,0 +1,104 @@
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "common/laser_scan.h"
+#include "common/pose2.h"
+
+namespace mjslam::explorer {
+
+/// Settings of the occupancy grid (a part of ExplorerParams, see
+/// explorer/explorer_params.h for the meaning and units of each field).
+struct OccupancyGridSettings {
+  double resolution_m = 0.05;
+  double max_insert_range_m = 8.0;
+  double no_return_free_range_m = 4.0;
+  double log_odds_hit = 0.85;
+  double log_odds_miss = -0.4;
+  double log_odds_min = -4.0;
+  double log_odds_max = 4.0;
+  double occupied_threshold = 0.6;
+  double free_threshold = -0.3;
+};
+
+/// State of one cell as the planner sees it.
+enum class CellState : std::uint8_t { kUnknown = 0, kFree = 1, kOccupied = 2 };
+
+/// A 2-D occupancy grid in log-odds (Probabilistic Robotics, ch. 9, the
+/// inverse sensor model of a range finder), in the world frame W. It starts
+/// empty and grows (in chunks of whole cells, keeping existing cells where they
+/// are) to cover every scan inserted, so no world bound is needed.
+///
+/// Departures from the textbook model: each cell is updated at most once per
+/// scan; the free space between two consecutive beams is filled up to the
+/// shorter of the two ranges (sub-rays), so that far-away free space has no
+/// unknown holes between diverging beams; echoes beyond `max_insert_range_m`
+/// only clear free space up to that range, and no-return beams clear free
+/// space up to `no_return_free_range_m` only (the SICK reports no echo for
+/// dark or distant surfaces, so "nothing up to 30 m" is not trusted).
+class OccupancyGrid {
+ public:
+  /// `settings` must be valid (ExplorerParams::Validate checks them).
+  explicit OccupancyGrid(const OccupancyGridSettings& settings);
+
+  /// Inserts one scan taken with the laser frame S at `X_WS`.
+  void InsertScan(const LaserScan& scan, const Pose2& X_WS);
+
+  /// Marks every cell whose centre lies in the rectangle [x0, x1] x [-hw, hw]
+  /// of the frame at `X_WB` as free (once, with `log_odds_miss`): the robot's
+  /// own body stands there, so it is not an obstacle.
+  void MarkRectangleFree(const Pose2& X_WB, double x0_m, double x1_m, double half_width_m);
+
+  /// Cell size, metres.
+  double resolution() const { return settings_.resolution_m; }
+  /// Grid size in cells (0 before the first insertion).
+  int width() const { return width_; }
+  int height() const { return height_; }
+  /// World coordinates of the corner of cell (0, 0), metres.
+  Eigen::Vector2d origin() const { return origin_; }
+
+  /// True when (ix, iy) lies inside the grid.
+  bool Contains(int ix, int iy) const {
+    return ix >= 0 && iy >= 0 && ix < width_ && iy < height_;
+  }
+  /// Linear index of cell (ix, iy), which must be inside.
+  int Index(int ix, int iy) const { return iy * width_ + ix; }
+  /// Cell containing the world point `p_W` (may be outside the grid).
+  Eigen::Vector2i CellOf(const Eigen::Vector2d& p_W) const;
+  /// World coordinates of the centre of cell (ix, iy).
+  Eigen::Vector2d CellCenter(int ix, int iy) const;
+
+  /// Log-odds of a cell; 0 (unknown) outside the grid.
+  double LogOdds(int ix, int iy) const;
+  /// State of a cell from the thresholds; unknown outside the grid.
+  CellState State(int ix, int iy) const;
+  /// State of the cell containing `p_W`.
+  CellState StateAt(const Eigen::Vector2d& p_W) const;
+
+  /// Area of the cells in each state, m^2 (for reports and tests).
+  double KnownFreeArea() const;
+
+ private:
+  // Grows the grid so that it covers the axis-aligned box [lo, hi] (world).
+  void EnsureCovers(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi);
+  // Marks the cells along the ray from `from` to `to` (excluding the cell of
+  // `to` when `exclude_end`) for a free update in this scan.
+  void MarkRayFree(const Eigen::Vector2d& from, const Eigen::Vector2d& to);
+  // Applies the marks of this scan and clears them.
+  void ApplyMarks();
+
+  OccupancyGridSettings settings_;
+  Eigen::Vector2d origin_ = Eigen::Vector2d::Zero();
+  int width_ = 0;
+  int height_ = 0;
+  std::vector<float> log_odds_;
+  // Per-scan update marks: 0 none, 1 free, 2 occupied; `touched_` lists the
+  // marked cells.
+  std::vector<std::uint8_t> marks_;
+  std::vector<int> touched_;
+};
+
+}  // namespace mjslam::explorer

@@ -1,0 +1,365 @@
+#include "explorer/path_planner.h"
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <queue>
+#include <utility>
+
+#include "common/angles.h"
+#include "common/check.h"
+
+namespace mjslam::explorer {
+namespace {
+
+constexpr double kInfinity = std::numeric_limits<double>::infinity();
+// Squared distance standing for "no occupied cell", cells^2.
+constexpr double kFar = 1e12;
+
+// One-dimensional squared Euclidean distance transform of `f` (n samples)
+// into `d` (Felzenszwalb and Huttenlocher 2012, Algorithm 1).
+void DistanceTransform1d(const std::vector<double>& f, int n, std::vector<double>* d) {
+  std::vector<int> v(n);
+  std::vector<double> z(n + 1);
+  int k = 0;
+  v[0] = 0;
+  z[0] = -kInfinity;
+  z[1] = kInfinity;
+  for (int q = 1; q < n; ++q) {
+    double s = 0.0;
+    while (true) {
+      s = ((f[q] + double(q) * q) - (f[v[k]] + double(v[k]) * v[k])) / (2.0 * q - 2.0 * v[k]);
+      if (s <= z[k] && k > 0) {
+        --k;
+      } else {
+        break;
+      }
+    }
+    if (s <= z[k]) {  // k == 0: replace the only parabola
+      v[0] = q;
+      z[0] = -kInfinity;
+      z[1] = kInfinity;
+      continue;
+    }
+    ++k;
+    v[k] = q;
+    z[k] = s;
+    z[k + 1] = kInfinity;
+  }
+  k = 0;
+  for (int q = 0; q < n; ++q) {
+    while (z[k + 1] < q) ++k;
+    (*d)[q] = (double(q) - v[k]) * (double(q) - v[k]) + f[v[k]];
+  }
+}
+
+Eigen::Vector2d LeftNormal(const Eigen::Vector2d& u) { return {-u.y(), u.x()}; }
+
+double Cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  return a.x() * b.y() - a.y() * b.x();
+}
+
+// Appends points every `step` along the segment [a, b) (b excluded).
+void AppendSegment(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double step, Path* path) {
+  const double length = (b - a).norm();
+  if (length < 1e-9) return;
+  const Eigen::Vector2d u = (b - a) / length;
+  const int n = std::max(1, static_cast<int>(std::ceil(length / step)));
+  for (int k = 0; k < n; ++k) {
+    PathPoint point;
+    point.p_W = a + (length * k / n) * u;
+    point.heading_rad = std::atan2(u.y(), u.x());
+    path->push_back(point);
+  }
+}
+
+}  // namespace
+
+NavigationMap::NavigationMap(const OccupancyGrid& grid, const ExplorerParams& params,
+                             const Eigen::Vector2d& p_W_start)
+    : grid_(grid), params_(params), p_W_start_(p_W_start), start_(grid.CellOf(p_W_start)) {
+  const int w = grid_.width();
+  const int h = grid_.height();
+  const int n = w * h;
+  clearance_.assign(n, 0.0f);
+  cost_.assign(n, std::numeric_limits<float>::infinity());
+  parent_.assign(n, -1);
+  if (n == 0) return;
+
+  // Clearance: exact Euclidean distance transform of the occupied cells,
+  // columns then rows.
+  std::vector<double> squared(n);
+  for (int i = 0; i < n; ++i) {
+    squared[i] = grid_.State(i % w, i / w) == CellState::kOccupied ? 0.0 : kFar;
+  }
+  {
+    std::vector<double> f(h), d(h);
+    for (int ix = 0; ix < w; ++ix) {
+      for (int iy = 0; iy < h; ++iy) f[iy] = squared[iy * w + ix];
+      DistanceTransform1d(f, h, &d);
+      for (int iy = 0; iy < h; ++iy) squared[iy * w + ix] = d[iy];
+    }
+  }
+  {
+    std::vector<double> f(w), d(w);
+    for (int iy = 0; iy < h; ++iy) {
+      for (int ix = 0; ix < w; ++ix) f[ix] = squared[iy * w + ix];
+      DistanceTransform1d(f, w, &d);
+      for (int ix = 0; ix < w; ++ix) squared[iy * w + ix] = d[ix];
+    }
+  }
+  for (int i = 0; i < n; ++i) {
+    clearance_[i] = static_cast<float>(std::sqrt(std::min(squared[i], kFar)) * grid_.resolution());
+  }
+
+  // Dijkstra from the start cell, ties broken by cell index (deterministic).
+  if (!grid_.Contains(start_.x(), start_.y())) return;
+  const double r = grid_.resolution();
+  using Entry = std::pair<double, int>;
+  std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> open;
+  const int start_index = grid_.Index(start_.x(), start_.y());
+  cost_[start_index] = 0.0f;
+  open.push({0.0, start_index});
+  const int dx[8] = {1, -1, 0, 0, 1, 1, -1, -1};
+  const int dy[8] = {0, 0, 1, -1, 1, -1, 1, -1};
+  while (!open.empty()) {
+    const auto [cost, index] = open.top();
+    open.pop();
+    if (cost > cost_[index]) continue;
+    const int ix = index % w;
+    const int iy = index / w;
+    for (int k = 0; k < 8; ++k) {
+      const int jx = ix + dx[k];
+      const int jy = iy + dy[k];
+      if (!Traversable(jx, jy)) continue;
+      // Diagonal moves must not cut the corner of a blocked cell.
+      if (k >= 4 && (!Traversable(ix + dx[k], iy) || !Traversable(ix, iy + dy[k]))) continue;
+      const int j = grid_.Index(jx, jy);
+      const double shortfall =
+          std::max(0.0, params_.preferred_clearance_m - clearance_[j]) /
+          params_.preferred_clearance_m;
+      const double step = (k < 4 ? r : r * std::sqrt(2.0)) *
+                          (1.0 + params_.clearance_cost_weight * shortfall);
+      const double next = cost + step;
+      if (next < cost_[j]) {
+        cost_[j] = static_cast<float>(next);
+        parent_[j] = index;
+        open.push({cost_[j], j});
+      }
+    }
+  }
+}
+
+double NavigationMap::Clearance(int ix, int iy) const {
+  return grid_.Contains(ix, iy) ? clearance_[grid_.Index(ix, iy)] : 0.0;
+}
+
+double NavigationMap::ClearanceAt(const Eigen::Vector2d& p_W) const {
+  const Eigen::Vector2i c = grid_.CellOf(p_W);
+  return Clearance(c.x(), c.y());
+}
+
+bool NavigationMap::Traversable(int ix, int iy) const {
+  if (!grid_.Contains(ix, iy)) return false;
+  const CellState state = grid_.State(ix, iy);
+  if (state == CellState::kOccupied) return false;
+  const Eigen::Vector2d p = grid_.CellCenter(ix, iy);
+  if ((p - p_W_start_).norm() <= params_.escape_radius_m) return true;
+  return state == CellState::kFree && clearance_[grid_.Index(ix, iy)] >= params_.clearance_m;
+}
+
+bool NavigationMap::TraversableAt(const Eigen::Vector2d& p_W) const {
+  const Eigen::Vector2i c = grid_.CellOf(p_W);
+  return Traversable(c.x(), c.y());
+}
+
+double NavigationMap::CostTo(int ix, int iy) const {
+  if (!grid_.Contains(ix, iy)) return kInfinity;
+  return cost_[grid_.Index(ix, iy)];
+}
+
+bool NavigationMap::SegmentTraversable(const Eigen::Vector2d& a_W,
+                                       const Eigen::Vector2d& b_W) const {
+  const double length = (b_W - a_W).norm();
+  const int n = std::max(1, static_cast<int>(std::ceil(length / (0.5 * grid_.resolution()))));
+  for (int k = 0; k <= n; ++k) {
+    if (!TraversableAt(a_W + (double(k) / n) * (b_W - a_W))) return false;
+  }
+  return true;
+}
+
+std::vector<Eigen::Vector2i> NavigationMap::CellPath(const Eigen::Vector2i& goal) const {
+  std::vector<Eigen::Vector2i> cells;
+  if (!std::isfinite(CostTo(goal.x(), goal.y()))) return cells;
+  for (int i = grid_.Index(goal.x(), goal.y()); i >= 0; i = parent_[i]) {
+    cells.emplace_back(i % grid_.width(), i / grid_.width());
+  }
+  std::reverse(cells.begin(), cells.end());
+  return cells;
+}
+
+Path SmoothPolyline(const std::vector<Eigen::Vector2d>& vertices, const NavigationMap* map,
+                    const ExplorerParams& params) {
+  MJSLAM_CHECK(vertices.size() >= 2);
+  const int n = static_cast<int>(vertices.size());
+  const double step = params.path_step_m;
+  Path path;
+  Eigen::Vector2d cursor = vertices[0];
+  for (int k = 1; k < n; ++k) {
+    const Eigen::Vector2d& v = vertices[k];
+    if (k == n - 1) {
+      AppendSegment(cursor, v, step, &path);
+      break;
+    }
+    const Eigen::Vector2d in = vertices[k] - vertices[k - 1];
+    const Eigen::Vector2d out = vertices[k + 1] - vertices[k];
+    const Eigen::Vector2d u_in = in.normalized();
+    const Eigen::Vector2d u_out = out.normalized();
+    const double turn = std::atan2(Cross(u_in, u_out), u_in.dot(u_out));  // signed
+    const double phi = std::abs(turn);
+    if (phi < 1e-6) continue;  // collinear: no corner
+    // Largest tangent length: the whole free part of the first and last
+    // legs, half of the inner legs (the neighbouring corner gets the rest).
+    const double available_in =
+        k == 1 ? (v - cursor).norm() : std::min((v - cursor).norm(), 0.5 * in.norm());
+    const double available_out = k + 1 == n - 1 ? out.norm() : 0.5 * out.norm();
+    const double tan_half = std::tan(0.5 * phi);
+    double radius = std::min(params.max_turn_radius_m,
+                             phi > kPi - 1e-6 ? 0.0 : std::min(available_in, available_out) /
+                                                           tan_half);
+    // Shrink the arc until it stays traversable.
+    bool rounded = false;
+    Path arc;
+    while (radius >= params.min_turn_radius_m) {
+      const double d = radius * tan_half;
+      const Eigen::Vector2d t_in = v - d * u_in;
+      const double sign = turn > 0 ? 1.0 : -1.0;
+      const Eigen::Vector2d center = t_in + sign * radius * LeftNormal(u_in);
+      const double arc_length = radius * phi;
+      const int m = std::max(1, static_cast<int>(std::ceil(arc_length / step)));
+      const double start_angle = std::atan2(t_in.y() - center.y(), t_in.x() - center.x());
+      arc.clear();
+      bool ok = map == nullptr || map->SegmentTraversable(cursor, t_in);
+      for (int j = 0; j < m && ok; ++j) {
+        const double angle = start_angle + sign * phi * j / m;
+        PathPoint point;
+        point.p_W = center + radius * Eigen::Vector2d(std::cos(angle), std::sin(angle));
+        point.heading_rad = WrapAngle(std::atan2(u_in.y(), u_in.x()) + sign * phi * j / m);
+        point.curvature_per_m = sign / radius;
+        ok = map == nullptr || map->TraversableAt(point.p_W);
+        arc.push_back(point);
+      }
+      if (ok) {
+        AppendSegment(cursor, t_in, step, &path);
+        path.insert(path.end(), arc.begin(), arc.end());
+        cursor = v + d * u_out;
+        rounded = true;
+        break;
+      }
+      radius *= 0.7;
+    }
+    if (!rounded) {
+      // Stop at the corner and turn in place.
+      AppendSegment(cursor, v, step, &path);
+      PathPoint corner;
+      corner.p_W = v;
+      corner.heading_rad = std::atan2(u_out.y(), u_out.x());
+      corner.turn_in_place = true;
+      path.push_back(corner);
+      cursor = v;
+    }
+  }
+  // The last point, the goal.
+  PathPoint last;
+  last.p_W = vertices.back();
+  last.heading_rad = path.empty() ? 0.0 : path.back().heading_rad;
+  if (!path.empty() && (path.back().p_W - last.p_W).norm() > 1e-9) {
+    const Eigen::Vector2d u = last.p_W - path.back().p_W;
+    last.heading_rad = std::atan2(u.y(), u.x());
+  }
+  path.push_back(last);
+  // Remove a stop-and-turn point that duplicates the previous point.
+  for (size_t i = 1; i < path.size(); ++i) {
+    path[i].s_m = path[i - 1].s_m + (path[i].p_W - path[i - 1].p_W).norm();
+  }
+
+  // Speed profile: curvature limits, then acceleration toward every stop.
+  const int size = static_cast<int>(path.size());
+  for (int i = 0; i < size; ++i) {
+    PathPoint& point = path[i];
+    double v = params.cruise_speed_mps;
+    const double kappa = std::abs(point.curvature_per_m);
+    if (kappa > 0.0) {
+      v = std::min({v, params.max_angular_speed_radps / kappa,
+                    std::sqrt(params.max_lateral_accel_mps2 / kappa)});
+    }
+    if (point.turn_in_place || i + 1 == size) v = 0.0;
+    point.speed_mps = v;
+  }
+  for (int i = size - 2; i >= 0; --i) {
+    const double ds = path[i + 1].s_m - path[i].s_m;
+    path[i].speed_mps = std::min(
+        path[i].speed_mps,
+        std::sqrt(path[i + 1].speed_mps * path[i + 1].speed_mps +
+                  2.0 * params.max_linear_accel_mps2 * ds));
+  }
+  return path;
+}
+
+Path PlanPath(const NavigationMap& map, const ExplorerParams& params,
+              const Eigen::Vector2d& p_W_goal, double heading_rad) {
+  const OccupancyGrid& grid = map.grid();
+  const std::vector<Eigen::Vector2i> cells = map.CellPath(grid.CellOf(p_W_goal));
+  if (cells.empty()) return {};
+  // Cell centres, starting at the start point itself.
+  std::vector<Eigen::Vector2d> points;
+  points.push_back(grid.CellCenter(cells.front().x(), cells.front().y()));
+  for (size_t i = 1; i < cells.size(); ++i) {
+    points.push_back(grid.CellCenter(cells[i].x(), cells[i].y()));
+  }
+  if (points.size() == 1) points.push_back(points.front());
+  // Line-of-sight shortcuts.
+  std::vector<Eigen::Vector2d> vertices = {points.front()};
+  size_t i = 0;
+  while (i + 1 < points.size()) {
+    size_t j = i + 1;
+    while (j + 1 < points.size() && map.SegmentTraversable(points[i], points[j + 1])) ++j;
+    vertices.push_back(points[j]);
+    i = j;
+  }
+  // Drop a degenerate first leg.
+  if (vertices.size() > 2 && (vertices[1] - vertices[0]).norm() < 1e-9) {
+    vertices.erase(vertices.begin() + 1);
+  }
+  if ((vertices.back() - vertices.front()).norm() < 1e-9) {
+    PathPoint only;
+    only.p_W = vertices.front();
+    only.heading_rad = heading_rad;
+    return {only};
+  }
+  Path path = SmoothPolyline(vertices, &map, params);
+  // Turn toward the first leg first when it leaves far off the heading.
+  if (path.size() >= 2) {
+    const double error = WrapAngle(path.front().heading_rad - heading_rad);
+    if (std::abs(error) > DegToRad(params.turn_in_place_deg)) {
+      path.front().turn_in_place = true;
+      path.front().speed_mps = 0.0;
+      path.front().curvature_per_m = 0.0;
+    }
+  }
+  return path;
+}
+
+bool PathClearOfPoints(const Path& path, int from,
+                       const std::vector<Eigen::Vector2d>& obstacles_W, double clearance_m) {
+  const double squared = clearance_m * clearance_m;
+  for (int i = std::max(0, from); i < static_cast<int>(path.size()); ++i) {
+    for (const Eigen::Vector2d& q : obstacles_W) {
+      if ((path[i].p_W - q).squaredNorm() < squared) return false;
+    }
+  }
+  return true;
+}
+
+}  // namespace mjslam::explorer

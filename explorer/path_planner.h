@@ -1,0 +1,100 @@
+#pragma once
+
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "explorer/explorer_params.h"
+#include "explorer/occupancy_grid.h"
+
+namespace mjslam::explorer {
+
+/// One point of a planned path of h, in the world frame W.
+struct PathPoint {
+  /// Position of h, metres.
+  Eigen::Vector2d p_W = Eigen::Vector2d::Zero();
+  /// Direction of travel, radians.
+  double heading_rad = 0.0;
+  /// Signed curvature (left positive), 1/m; 0 at stop-and-turn points.
+  double curvature_per_m = 0.0;
+  /// Reference speed of h, m/s (0 at stop-and-turn points and at the end).
+  double speed_mps = 0.0;
+  /// Arc length from the start, metres.
+  double s_m = 0.0;
+  /// The robot stops here and turns in place to `heading_rad` (a corner that
+  /// no arc of at least `min_turn_radius_m` could round).
+  bool turn_in_place = false;
+};
+
+/// A path is its points in order; empty when there is none.
+using Path = std::vector<PathPoint>;
+
+/// The grid seen by the planner: the clearance of every cell (Euclidean
+/// distance to the nearest occupied cell, by the exact distance transform of
+/// Felzenszwalb and Huttenlocher, "Distance Transforms of Sampled Functions",
+/// 2012) and the cost to reach every cell from a start point (Dijkstra,
+/// 8-connected, on known-free cells with at least `clearance_m`; each step
+/// costs its length times 1 + `clearance_cost_weight` * the shortfall of
+/// clearance below `preferred_clearance_m`, relative). Cells within
+/// `escape_radius_m` of the start need only be not occupied, so that a robot
+/// stopped close to a wall can plan its way out.
+class NavigationMap {
+ public:
+  /// Builds the map of `grid` (which must outlive it) from `p_W_start`.
+  NavigationMap(const OccupancyGrid& grid, const ExplorerParams& params,
+                const Eigen::Vector2d& p_W_start);
+
+  const OccupancyGrid& grid() const { return grid_; }
+  /// Clearance of a cell, metres (large when there is no occupied cell;
+  /// 0 outside the grid).
+  double Clearance(int ix, int iy) const;
+  /// Clearance at a world point (its cell), metres.
+  double ClearanceAt(const Eigen::Vector2d& p_W) const;
+  /// Whether h may stand in the cell (the rules above).
+  bool Traversable(int ix, int iy) const;
+  /// Whether h may stand at the world point.
+  bool TraversableAt(const Eigen::Vector2d& p_W) const;
+  /// Path cost from the start to the cell, metres (infinity if unreachable).
+  double CostTo(int ix, int iy) const;
+  /// Whether every point of the segment is traversable (sampled at half a cell).
+  bool SegmentTraversable(const Eigen::Vector2d& a_W, const Eigen::Vector2d& b_W) const;
+  /// Cells from the start to `goal` (inclusive), empty if unreachable.
+  std::vector<Eigen::Vector2i> CellPath(const Eigen::Vector2i& goal) const;
+  /// The start cell.
+  Eigen::Vector2i start_cell() const { return start_; }
+
+ private:
+  const OccupancyGrid& grid_;
+  ExplorerParams params_;
+  Eigen::Vector2d p_W_start_;
+  Eigen::Vector2i start_;
+  std::vector<float> clearance_;
+  std::vector<float> cost_;
+  std::vector<int> parent_;
+};
+
+/// Plans a kinematically feasible path of h from the map's start to
+/// `p_W_goal` (which must be reachable in `map`): the Dijkstra cell path,
+/// shortened by line of sight over traversable cells, then its corners rounded
+/// with circular arcs of radius between `min_turn_radius_m` and
+/// `max_turn_radius_m` that stay traversable (a corner where none fits becomes
+/// a stop-and-turn point: the differential drive turns in place there). The
+/// speed profile respects `cruise_speed_mps`, the angular speed limit and the
+/// lateral acceleration on arcs, and `max_linear_accel_mps2` toward every stop.
+/// `heading_rad` is the robot's heading: when the first leg leaves more than
+/// `turn_in_place_deg` off it, the path starts with a stop-and-turn point.
+/// Returns an empty path when the goal is unreachable.
+Path PlanPath(const NavigationMap& map, const ExplorerParams& params,
+              const Eigen::Vector2d& p_W_goal, double heading_rad);
+
+/// Rounds the corners of a polyline as PlanPath does (exposed for tests):
+/// `vertices` in W, at least two; `map` may be null (no collision check).
+Path SmoothPolyline(const std::vector<Eigen::Vector2d>& vertices, const NavigationMap* map,
+                    const ExplorerParams& params);
+
+/// Whether every point of `path` from index `from` on keeps `clearance_m`
+/// from every point of `obstacles_W` (scan echoes), metres.
+bool PathClearOfPoints(const Path& path, int from,
+                       const std::vector<Eigen::Vector2d>& obstacles_W, double clearance_m);
+
+}  // namespace mjslam::explorer

@@ -1,0 +1,135 @@
+#include <cmath>
+#include <limits>
+
+#include <gtest/gtest.h>
+
+#include "explorer/explorer.h"
+#include "explorer/path_tracker.h"
+#include "tests/explorer/kinematic_sim.h"
+
+namespace mjslam::explorer {
+namespace {
+
+double DistanceToPath(const Path& path, const Eigen::Vector2d& p) {
+  double best = std::numeric_limits<double>::infinity();
+  for (const PathPoint& q : path) best = std::min(best, (q.p_W - p).norm());
+  return best;
+}
+
+// Follows `path` from `start` in an empty world; returns the largest
+// distance of h from the path after the first `settle_m` travelled.
+double Follow(const Path& path, const Pose2& start, double settle_m, bool* done,
+              const ExplorerParams& params) {
+  testing::KinematicSim::Config config;
+  testing::KinematicSim sim({}, start, config);
+  PathTracker tracker(params, config.a_m);
+  tracker.SetPath(path);
+  double worst = 0.0;
+  for (int k = 0; k < 1000 && !tracker.done(); ++k) {
+    const Twist2 u = tracker.Command(sim.X_WR(), 0.1);
+    EXPECT_LE(std::abs(u.v_mps), params.max_linear_speed_mps + 1e-12);
+    EXPECT_LE(std::abs(u.w_radps), params.max_angular_speed_radps + 1e-12);
+    sim.Step(u, 0.1);
+    if (sim.distance_m() > settle_m) worst = std::max(worst, DistanceToPath(path, sim.X_WR().translation()));
+  }
+  *done = tracker.done();
+  return worst;
+}
+
+TEST(PathTrackerTest, ConvergesOnAReferencePathAndReachesItsEnd) {
+  const ExplorerParams params;
+  const Path path = SmoothPolyline({{0, 0}, {4, 0}, {4, 4}, {1, 5}}, nullptr, params);
+  bool done = false;
+  // Starting 0.3 m off the path and 0.4 rad off its heading.
+  const double worst = Follow(path, Pose2(0.0, -0.3, 0.4), 1.0, &done, params);
+  EXPECT_TRUE(done);
+  EXPECT_LT(worst, 0.08);
+}
+
+TEST(PathTrackerTest, TurnsInPlaceAtAStopPoint) {
+  const ExplorerParams params;
+  const Path path = SmoothPolyline({{0, 0}, {2, 0}, {0, 0.1}}, nullptr, params);
+  bool done = false;
+  const double worst = Follow(path, Pose2(0.0, 0.0, 0.0), 0.0, &done, params);
+  EXPECT_TRUE(done);
+  // Turning in place swings h on a circle of radius a = 0.2 m about the
+  // axle: h leaves the path by up to a while it turns, and no more.
+  EXPECT_LT(worst, 0.2 + 0.03);
+}
+
+TEST(PathTrackerTest, TurnsFirstWhenThePathStartsBehind) {
+  const ExplorerParams params;
+  const Path path = SmoothPolyline({{0, 0}, {-3, 0}}, nullptr, params);
+  testing::KinematicSim sim({}, Pose2(0.0, 0.0, 0.0), {});
+  PathTracker tracker(params, 0.2);
+  tracker.SetPath(path);
+  const Twist2 u = tracker.Command(sim.X_WR(), 0.1);
+  EXPECT_EQ(u.v_mps, 0.0);  // never backward, never forward away from it
+  EXPECT_NE(u.w_radps, 0.0);
+}
+
+TEST(SafetyFilterTest, StopsBeforeAWallAhead) {
+  const ExplorerParams params;
+  // A wall across the way, 0.06 m ahead of h (the body's front edge is
+  // 0.02 m behind h, plus 0.05 m margin: 0.03 m to spare).
+  std::vector<Eigen::Vector2d> wall;
+  for (double y = -1.0; y <= 1.0; y += 0.02) wall.emplace_back(0.06, y);
+  bool limited = false;
+  const Twist2 u = SafetyFilter({0.4, 0.0}, Pose2(), wall, params, 0.2, 0.1, &limited);
+  EXPECT_TRUE(limited);
+  EXPECT_EQ(u.v_mps, 0.0);
+  // Farther away (0.15 m): half the speed still stops in time.
+  std::vector<Eigen::Vector2d> farther;
+  for (double y = -1.0; y <= 1.0; y += 0.02) farther.emplace_back(0.15, y);
+  const Twist2 slower = SafetyFilter({0.4, 0.0}, Pose2(), farther, params, 0.2, 0.1, &limited);
+  EXPECT_TRUE(limited);
+  EXPECT_EQ(slower.v_mps, 0.2);
+  // Turning in place there is safe (the wall is ahead of the body).
+  const Twist2 turn = SafetyFilter({0.0, 1.0}, Pose2(), wall, params, 0.2, 0.1, &limited);
+  EXPECT_FALSE(limited);
+  EXPECT_EQ(turn.w_radps, 1.0);
+}
+
+TEST(SafetyFilterTest, LeavesAFreeWayAlone) {
+  const ExplorerParams params;
+  std::vector<Eigen::Vector2d> far_wall;
+  for (double y = -1.0; y <= 1.0; y += 0.02) far_wall.emplace_back(1.5, y);
+  bool limited = true;
+  const Twist2 u = SafetyFilter({0.4, 0.1}, Pose2(), far_wall, params, 0.2, 0.1, &limited);
+  EXPECT_FALSE(limited);
+  EXPECT_EQ(u.v_mps, 0.4);
+  EXPECT_EQ(u.w_radps, 0.1);
+}
+
+TEST(SafetyFilterTest, LongCommandPeriodStopsEarlier) {
+  const ExplorerParams params;
+  std::vector<Eigen::Vector2d> wall;
+  for (double y = -1.0; y <= 1.0; y += 0.02) wall.emplace_back(0.3, y);
+  bool limited = false;
+  // 0.4 m/s held 0.1 s: 4 cm plus 10 cm braking, fine; held 0.7 s (a slow
+  // filter's period): 28 cm plus braking, too far.
+  SafetyFilter({0.4, 0.0}, Pose2(), wall, params, 0.2, 0.1, &limited);
+  EXPECT_FALSE(limited);
+  SafetyFilter({0.4, 0.0}, Pose2(), wall, params, 0.2, 0.7, &limited);
+  EXPECT_TRUE(limited);
+}
+
+TEST(ExplorerParamsTest, DefaultsAreValidAndBadValuesAreNamed) {
+  EXPECT_TRUE(ExplorerParams{}.Validate().empty());
+  ExplorerParams params;
+  params.clearance_m = 0.1;
+  params.grid_resolution_m = -1.0;
+  try {
+    params.ValidateOrThrow();
+    FAIL() << "no throw";
+  } catch (const ParamError& error) {
+    const std::string what = error.what();
+    EXPECT_NE(what.find("explorer.clearance_m"), std::string::npos) << what;
+    EXPECT_NE(what.find("0.1"), std::string::npos) << what;
+    EXPECT_NE(what.find("explorer.grid_resolution_m"), std::string::npos) << what;
+  }
+  EXPECT_THROW(Explorer(ExplorerParams{}, 0.0), ParamError);
+}
+
+}  // namespace
+}  // namespace mjslam::explorer
