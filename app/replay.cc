@@ -104,7 +104,12 @@ void Replay(const RunConfig& config, const ReplayOptions& options) {
   WriteJsonAtomically(dir + "/manifest.json", manifest);
 
   try {
-    SlamPair slam(config.slam, X_WR0, X_RS);
+    SlamPair slam(config.slam, config.control, 1.0 / config.run.control_rate_hz, X_WR0, X_RS);
+    // The explored fraction is the run's (it needs the world), when it has one.
+    int explored_col = -1;
+    for (std::size_t c = 0; c < input.columns.size(); ++c) {
+      if (input.columns[c] == "explored") explored_col = static_cast<int>(c);
+    }
     CsvWriter trajectory(dir + "/trajectory.csv", TrajectoryColumns());
     Progress progress("replay", static_cast<double>(input.rows.size()));
     Twist2 held;
@@ -135,7 +140,12 @@ void Replay(const RunConfig& config, const ReplayOptions& options) {
       previous_t = record.t_s;
 
       for (int c = 0; c <= cmd_col + 1; ++c) trajectory.Add(row[c]);
-      slam.AddColumns(&trajectory);
+      if (explored_col >= 0) {
+        trajectory.Add(row[explored_col]);
+      } else {
+        trajectory.AddEmpty();
+      }
+      slam.AddColumns(pose_at(row, true_col), &trajectory);
       trajectory.EndRow();
       progress.Update(static_cast<double>(i));
     }

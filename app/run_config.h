@@ -4,7 +4,9 @@
 #include <string>
 #include <vector>
 
+#include "app/control.h"
 #include "common/params.h"
+#include "explorer/explorer_params.h"
 #include "explorer/waypoint_driver.h"
 #include "sim/sim_params.h"
 #include "slam/slam_params.h"
@@ -47,6 +49,8 @@ struct RunConfig {
   sim::OdometryParams odometry;
   explorer::WaypointDriverParams driver;
   slam::SlamParams slam;
+  ControlParams control;
+  explorer::ExplorerParams explorer;
 
   template <typename Archive>
   void Serialize(Archive* a) {
@@ -57,6 +61,8 @@ struct RunConfig {
     a->Visit(MJSLAM_NVP(odometry));
     a->Visit(MJSLAM_NVP(driver));
     a->Visit(MJSLAM_NVP(slam));
+    a->Visit(MJSLAM_NVP(control));
+    a->Visit(MJSLAM_NVP(explorer));
   }
   std::vector<ParamProblem> Validate() const;
   void ValidateOrThrow() const { ThrowIfProblems(Validate()); }

@@ -1,9 +1,13 @@
 #include "app/slam_pair.h"
 
 #include <chrono>
+#include <limits>
 #include <string>
 
+#include <Eigen/Cholesky>
+
 #include "app/run_files.h"
+#include "common/angles.h"
 #include "slam/feature_extraction.h"
 
 namespace mjslam::app {
@@ -17,12 +21,13 @@ double MicrosecondsSince(Clock::time_point start) {
 
 }  // namespace
 
-SlamPair::SlamPair(const slam::SlamParams& params, const Pose2& X_WR0, const Pose2& X_RS)
-    : params_(params) {
+SlamPair::SlamPair(const slam::SlamParams& params, const ControlParams& control, double dt_s,
+                   const Pose2& X_WR0, const Pose2& X_RS)
+    : params_(params), control_(control), dt_s_(dt_s) {
   filters_.push_back(
-      {"classical", slam::EkfSlam(params.ekf, slam::CorrectionMode::kClassical, X_WR0, X_RS), {}, 0.0});
+      {"classical", slam::EkfSlam(params.ekf, slam::CorrectionMode::kClassical, X_WR0, X_RS)});
   filters_.push_back(
-      {"selective", slam::EkfSlam(params.ekf, slam::CorrectionMode::kSelective, X_WR0, X_RS), {}, 0.0});
+      {"selective", slam::EkfSlam(params.ekf, slam::CorrectionMode::kSelective, X_WR0, X_RS)});
 }
 
 void SlamPair::Step(const SensorRecord& record) {
@@ -37,6 +42,8 @@ void SlamPair::Step(const SensorRecord& record) {
     const Clock::time_point start = Clock::now();
     f.report = f.filter.Step(record, record.has_scan ? &features : nullptr);
     f.processing_us = extraction_us + MicrosecondsSince(start);
+    f.processing_s = ProcessingSeconds(control_, f.report, record.has_scan, f.processing_us);
+    f.period_steps = CommandPeriodSteps(f.processing_s, dt_s_);
   }
 }
 
@@ -44,14 +51,14 @@ std::vector<std::string> SlamPair::Columns() {
   std::vector<std::string> columns;
   for (const char* prefix : {"classical", "selective"}) {
     for (const char* name : {"x", "y", "th", "pxx", "pxy", "pxth", "pyy", "pyth", "pthth",
-                             "nfeat", "nmatched", "nupdated", "us"}) {
+                             "nfeat", "nmatched", "nupdated", "us", "period", "nees"}) {
       columns.push_back(std::string(prefix) + "_" + name);
     }
   }
   return columns;
 }
 
-void SlamPair::AddColumns(CsvWriter* writer) const {
+void SlamPair::AddColumns(const Pose2& X_WR_true, CsvWriter* writer) const {
   for (const Filter& f : filters_) {
     const Pose2 X_WR = f.filter.X_WR();
     const Eigen::Matrix3d P = f.filter.pose_covariance();
@@ -68,6 +75,8 @@ void SlamPair::AddColumns(CsvWriter* writer) const {
     writer->Add(f.report.num_matched);
     writer->Add(f.report.num_updated);
     writer->Add(f.processing_us);
+    writer->Add(f.period_steps * dt_s_);
+    writer->Add(PoseNees(X_WR, P, X_WR_true));
   }
 }
 
@@ -75,6 +84,17 @@ void SlamPair::WriteMaps(const std::string& dir) const {
   for (const Filter& f : filters_) {
     WriteMapCsv(dir + "/map_" + f.name + ".csv", f.filter.Map());
   }
+}
+
+double PoseNees(const Pose2& estimate, const Eigen::Matrix3d& P, const Pose2& truth) {
+  const Eigen::Vector3d e(estimate.x - truth.x, estimate.y - truth.y,
+                          WrapAngle(estimate.theta - truth.theta));
+  if (e.isZero(0.0)) return 0.0;
+  const Eigen::LDLT<Eigen::Matrix3d> ldlt(P);
+  if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0.0)) {
+    return std::numeric_limits<double>::infinity();
+  }
+  return e.dot(ldlt.solve(e));
 }
 
 void WriteMapCsv(const std::string& path, const std::vector<slam::MapFeature>& map) {

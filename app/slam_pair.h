@@ -3,6 +3,7 @@
 #include <string>
 #include <vector>
 
+#include "app/control.h"
 #include "app/csv_writer.h"
 #include "common/records.h"
 #include "slam/ekf_slam.h"
@@ -13,21 +14,34 @@ namespace mjslam::app {
 /// The two filters of the paper on the same records: the classical sequential
 /// EKF and the selective one. Features are extracted once per scan and given
 /// to both; each filter's processing time is that extraction plus its own
-/// step, measured with a steady clock.
+/// step, measured with a steady clock. Each filter's processing time also
+/// gives the command period it would impose (ControlParams).
 class SlamPair {
  public:
-  /// X_WR0: known initial pose of R; X_RS: the laser mount on R.
-  SlamPair(const slam::SlamParams& params, const Pose2& X_WR0, const Pose2& X_RS);
+  /// X_WR0: known initial pose of R; X_RS: the laser mount on R; `dt_s` the
+  /// control period without delay (one control step).
+  SlamPair(const slam::SlamParams& params, const ControlParams& control, double dt_s,
+           const Pose2& X_WR0, const Pose2& X_RS);
 
   /// Runs both filters on one record.
   void Step(const SensorRecord& record);
 
   /// The per-filter columns of trajectory.csv, for prefixes "classical" and
   /// "selective": f_x,f_y,f_th,f_pxx,f_pxy,f_pxth,f_pyy,f_pyth,f_pthth,
-  /// f_nfeat,f_nmatched,f_nupdated,f_us.
+  /// f_nfeat,f_nmatched,f_nupdated,f_us,f_period,f_nees.
   static std::vector<std::string> Columns();
-  /// Appends the values of Columns() for the last step.
-  void AddColumns(CsvWriter* writer) const;
+  /// Appends the values of Columns() for the last step; X_WR_true is the true
+  /// pose of R for the NEES.
+  void AddColumns(const Pose2& X_WR_true, CsvWriter* writer) const;
+
+  /// Processing time of filter `i` (0 classical, 1 selective) for the last
+  /// step, seconds (ControlParams::processing), and the command period it
+  /// imposes, in control steps.
+  double processing_s(int i) const { return filters_[i].processing_s; }
+  int period_steps(int i) const { return filters_[i].period_steps; }
+  /// Filter `i` by index, and its name.
+  const slam::EkfSlam& filter(int i) const { return filters_[i].filter; }
+  const std::string& name(int i) const { return filters_[i].name; }
 
   /// Writes map_classical.csv and map_selective.csv into `dir`.
   void WriteMaps(const std::string& dir) const;
@@ -41,13 +55,22 @@ class SlamPair {
     slam::EkfSlam filter;
     slam::StepReport report;
     double processing_us = 0.0;
+    double processing_s = 0.0;
+    int period_steps = 1;
   };
   slam::SlamParams params_;
+  ControlParams control_;
+  double dt_s_;
   std::vector<Filter> filters_;
 };
 
 /// Writes one filter map as CSV (id,type,p0,p1,c00,c01,c11,ax,ay,bx,by),
 /// atomically.
 void WriteMapCsv(const std::string& path, const std::vector<slam::MapFeature>& map);
+
+/// NEES of a pose estimate against the truth, e^T P^-1 e with the heading
+/// error wrapped; 0 when the error is zero (the known start, P = 0), and
+/// +infinity when P is singular along a nonzero error.
+double PoseNees(const Pose2& estimate, const Eigen::Matrix3d& P, const Pose2& truth);
 
 }  // namespace mjslam::app

@@ -141,9 +141,11 @@ NavigationMap::NavigationMap(const OccupancyGrid& grid, const ExplorerParams& pa
           params_.preferred_clearance_m;
       const double step = (k < 4 ? r : r * std::sqrt(2.0)) *
                           (1.0 + params_.clearance_cost_weight * shortfall);
-      const double next = cost + step;
+      // Compared as stored (float): a double compared with its own rounding
+      // would re-push a cell at an equal cost, without end.
+      const float next = static_cast<float>(cost + step);
       if (next < cost_[j]) {
-        cost_[j] = static_cast<float>(next);
+        cost_[j] = next;
         parent_[j] = index;
         open.push({cost_[j], j});
       }

@@ -189,7 +189,7 @@ StepReport EkfSlam::Step(const SensorRecord& record, const ScanFeatures* feature
   } else {
     RequireFinite(record.command.v_mps, "record.command.v_mps");
     RequireFinite(record.command.w_radps, "record.command.w_radps");
-    input = CommandInput(record.command, record.dt_s, params_.command_noise);
+    input = CommandInput(record.command, record.dt_s, params_.command_noise, previous_command_);
   }
   const double slip_std = params_.lateral_slip_std_m_per_rad * std::abs(input.increment.y());
   input.lateral_variance_m2 = slip_std * slip_std;
@@ -201,6 +201,7 @@ StepReport EkfSlam::Step(const SensorRecord& record, const ScanFeatures* feature
     X_OR_previous_ = record.X_OR;
     has_odometry_ = true;
   }
+  previous_command_ = record.command;
   state_.Predict(input, params_.control_point_offset_m);
 
   StepReport report;

@@ -150,6 +150,7 @@ class EkfSlam {
   double new_feature_threshold_;
   Pose2 X_OR_previous_;
   bool has_odometry_ = false;  // whether X_OR_previous_ holds a record's pose
+  Twist2 previous_command_;    // the command of the record before (zero at first)
   std::vector<FeatureInfo> info_;
   int next_id_ = 0;
 };

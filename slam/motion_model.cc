@@ -44,12 +44,15 @@ Eigen::Vector3d PredictPose(const Eigen::Vector3d& pose_WR, const Eigen::Vector2
   return predicted;
 }
 
-MotionInput CommandInput(const Twist2& command, double dt_s, const CommandNoiseParams& noise) {
+MotionInput CommandInput(const Twist2& command, double dt_s, const CommandNoiseParams& noise,
+                         const Twist2& previous) {
   MotionInput input;
   input.increment = Eigen::Vector2d(command.v_mps * dt_s, command.w_radps * dt_s);
-  const double sigma_v = noise.v_noise_std_mps + noise.v_noise_fraction * std::abs(command.v_mps);
+  const double sigma_v = noise.v_noise_std_mps + noise.v_noise_fraction * std::abs(command.v_mps) +
+                         noise.change_noise_fraction * std::abs(command.v_mps - previous.v_mps);
   const double sigma_w =
-      noise.w_noise_std_radps + noise.w_noise_fraction * std::abs(command.w_radps);
+      noise.w_noise_std_radps + noise.w_noise_fraction * std::abs(command.w_radps) +
+      noise.change_noise_fraction * std::abs(command.w_radps - previous.w_radps);
   input.covariance = Eigen::Vector2d(dt_s * dt_s * sigma_v * sigma_v,
                                      dt_s * dt_s * sigma_w * sigma_w)
                          .asDiagonal();

@@ -33,9 +33,12 @@ Eigen::Vector3d PredictPose(const Eigen::Vector3d& pose_WR, const Eigen::Vector2
                             Eigen::Matrix<double, 3, 2>* W = nullptr);
 
 /// The command held over `dt_s` (>= 0) as an input: increment (v dt, w dt),
-/// covariance diag((dt sigma_v)^2, (dt sigma_w)^2) with sigma_v, sigma_w from
-/// `noise` (CommandNoiseParams documents them).
-MotionInput CommandInput(const Twist2& command, double dt_s, const CommandNoiseParams& noise);
+/// covariance diag((dt sigma_v)^2, (dt sigma_w)^2) with
+///   sigma_v = v_noise_std_mps + v_noise_fraction |v|
+///             + change_noise_fraction |v - previous.v|   (likewise w),
+/// `previous` being the command of the record before (CommandNoiseParams).
+MotionInput CommandInput(const Twist2& command, double dt_s, const CommandNoiseParams& noise,
+                         const Twist2& previous);
 
 /// The wheel-odometry increment between two records as the equivalent input:
 /// the (d, dth) that PredictPose with offset `a_m` turns into the motion

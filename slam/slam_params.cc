@@ -10,6 +10,7 @@ std::vector<ParamProblem> CommandNoiseParams::Validate() const {
   check.NonNegative("v_noise_fraction", v_noise_fraction);
   check.NonNegative("w_noise_std_radps", w_noise_std_radps);
   check.NonNegative("w_noise_fraction", w_noise_fraction);
+  check.NonNegative("change_noise_fraction", change_noise_fraction);
   // A zero constant part would make a stopped robot's prediction exact.
   check.Require(v_noise_std_mps > 0.0 || w_noise_std_radps > 0.0, "v_noise_std_mps",
                 v_noise_std_mps, "a value > 0 when w_noise_std_radps is 0");

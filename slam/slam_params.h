@@ -24,6 +24,11 @@ struct CommandNoiseParams {
   double w_noise_std_radps = 0.03;
   /// Part of the angular-velocity noise proportional to |w| (dimensionless).
   double w_noise_fraction = 0.1;
+  /// Part of the noise proportional to the change of the command since the
+  /// previous record, |v - v_prev| and |w - w_prev| (dimensionless): the
+  /// wheels follow a step in the command with a lag, so the motion over the
+  /// period lies between the two commands.
+  double change_noise_fraction = 0.5;
 
   template <typename Archive>
   void Serialize(Archive* a) {
@@ -31,6 +36,7 @@ struct CommandNoiseParams {
     a->Visit(MJSLAM_NVP(v_noise_fraction));
     a->Visit(MJSLAM_NVP(w_noise_std_radps));
     a->Visit(MJSLAM_NVP(w_noise_fraction));
+    a->Visit(MJSLAM_NVP(change_noise_fraction));
   }
   /// Every out-of-range field, keys relative to this struct.
   std::vector<ParamProblem> Validate() const;

@@ -70,7 +70,7 @@ RunErrors Run(CorrectionMode mode, std::uint64_t seed, double reported_variance_
     // drawn from the filter's own noise model.
     record.command = Twist2{0.3, 0.3 / 2.5};
     if (step > 0) {
-      const MotionInput command = CommandInput(record.command, kDt, params.command_noise);
+      const MotionInput command = CommandInput(record.command, kDt, params.command_noise, record.command);
       const Eigen::Vector2d true_increment(
           command.increment.x() + motion_rng.Gaussian(0.0, std::sqrt(command.covariance(0, 0))),
           command.increment.y() + motion_rng.Gaussian(0.0, std::sqrt(command.covariance(1, 1))));

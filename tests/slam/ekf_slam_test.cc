@@ -142,10 +142,13 @@ TEST(EkfSlamTest, PredictsFromCommands) {
   }
   EXPECT_NEAR(filter.X_WR().x, 1.0, 1e-12);
   EXPECT_NEAR(filter.X_WR().y, 2.5, 1e-12);
-  // The covariance grew from zero along the motion: sigma_v dt per step.
+  // The covariance grew from zero along the motion: sigma_v dt per step, the
+  // first step also half the command's step from rest.
   const double sigma_v = params.command_noise.v_noise_std_mps +
                          params.command_noise.v_noise_fraction * 0.5;
-  EXPECT_NEAR(filter.pose_covariance()(1, 1), 10 * 0.01 * sigma_v * sigma_v, 1e-12);
+  const double sigma_first = sigma_v + params.command_noise.change_noise_fraction * 0.5;
+  EXPECT_NEAR(filter.pose_covariance()(1, 1),
+              0.01 * (sigma_first * sigma_first + 9 * sigma_v * sigma_v), 1e-12);
   EXPECT_GT(filter.pose_covariance()(0, 0), 0.0);
 }
 

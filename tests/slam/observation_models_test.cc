@@ -302,14 +302,20 @@ TEST(MotionModelTest, CommandInputScalesWithDt) {
   noise.v_noise_fraction = 0.1;
   noise.w_noise_std_radps = 0.01;
   noise.w_noise_fraction = 0.2;
-  const MotionInput input = CommandInput(Twist2{0.5, -0.4}, 0.2, noise);
+  noise.change_noise_fraction = 0.5;
+  const MotionInput input = CommandInput(Twist2{0.5, -0.4}, 0.2, noise, Twist2{0.5, -0.4});
   EXPECT_NEAR(input.increment.x(), 0.1, 1e-12);
   EXPECT_NEAR(input.increment.y(), -0.08, 1e-12);
   EXPECT_NEAR(std::sqrt(input.covariance(0, 0)), 0.2 * (0.02 + 0.05), 1e-12);
   EXPECT_NEAR(std::sqrt(input.covariance(1, 1)), 0.2 * (0.01 + 0.08), 1e-12);
   EXPECT_EQ(input.covariance(0, 1), 0.0);
+  // A step in the command from the previous record widens the noise by half
+  // the step: v from 0.3 (0.2 more), w from 0.8 (1.2 more).
+  const MotionInput step = CommandInput(Twist2{0.5, -0.4}, 0.2, noise, Twist2{0.3, 0.8});
+  EXPECT_NEAR(std::sqrt(step.covariance(0, 0)), 0.2 * (0.02 + 0.05 + 0.1), 1e-12);
+  EXPECT_NEAR(std::sqrt(step.covariance(1, 1)), 0.2 * (0.01 + 0.08 + 0.6), 1e-12);
   // No time, no motion, no noise.
-  const MotionInput still = CommandInput(Twist2{0.5, -0.4}, 0.0, noise);
+  const MotionInput still = CommandInput(Twist2{0.5, -0.4}, 0.0, noise, Twist2{});
   EXPECT_EQ(still.increment.norm(), 0.0);
   EXPECT_EQ(still.covariance.norm(), 0.0);
 }
