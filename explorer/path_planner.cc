@@ -83,7 +83,7 @@ NavigationMap::NavigationMap(const OccupancyGrid& grid, const ExplorerParams& pa
   const int h = grid_.height();
   const int n = w * h;
   clearance_.assign(n, 0.0f);
-  cost_.assign(n, std::numeric_limits<float>::infinity());
+  cost_.assign(n, kInfinity);
   parent_.assign(n, -1);
   if (n == 0) return;
 
@@ -119,7 +119,7 @@ NavigationMap::NavigationMap(const OccupancyGrid& grid, const ExplorerParams& pa
   using Entry = std::pair<double, int>;
   std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> open;
   const int start_index = grid_.Index(start_.x(), start_.y());
-  cost_[start_index] = 0.0f;
+  cost_[start_index] = 0.0;
   open.push({0.0, start_index});
   const int dx[8] = {1, -1, 0, 0, 1, 1, -1, -1};
   const int dy[8] = {0, 0, 1, -1, 1, -1, 1, -1};
@@ -143,7 +143,7 @@ NavigationMap::NavigationMap(const OccupancyGrid& grid, const ExplorerParams& pa
                           (1.0 + params_.clearance_cost_weight * shortfall);
       const double next = cost + step;
       if (next < cost_[j]) {
-        cost_[j] = static_cast<float>(next);
+        cost_[j] = next;
         parent_[j] = index;
         open.push({cost_[j], j});
       }

@@ -69,7 +69,7 @@ class NavigationMap {
   Eigen::Vector2d p_W_start_;
   Eigen::Vector2i start_;
   std::vector<float> clearance_;
-  std::vector<float> cost_;
+  std::vector<double> cost_;
   std::vector<int> parent_;
 };
 
