@@ -154,7 +154,7 @@ void Explorer::ChooseGoal(const Pose2& X_WR, double t_s) {
       for (int iy = c.y() - window; iy <= c.y() + window; ++iy) {
         for (int ix = c.x() - window; ix <= c.x() + window; ++ix) {
           const double cost = map.CostTo(ix, iy);
-          if (!std::isfinite(cost)) continue;
+          if (!std::isfinite(cost) || !map.Comfortable(ix, iy)) continue;
           const Eigen::Vector2d cell = grid_.CellCenter(ix, iy);
           const double distance = (cell - p).norm();
           if (distance > params_.view_distance_m) continue;

@@ -115,6 +115,7 @@ NavigationMap::NavigationMap(const OccupancyGrid& grid, const ExplorerParams& pa
 
   // Dijkstra from the start cell, ties broken by cell index (deterministic).
   if (!grid_.Contains(start_.x(), start_.y())) return;
+  escape_ = !Comfortable(start_.x(), start_.y());
   const double r = grid_.resolution();
   using Entry = std::pair<double, int>;
   std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> open;
@@ -164,9 +165,15 @@ bool NavigationMap::Traversable(int ix, int iy) const {
   if (!grid_.Contains(ix, iy)) return false;
   const CellState state = grid_.State(ix, iy);
   if (state == CellState::kOccupied) return false;
-  const Eigen::Vector2d p = grid_.CellCenter(ix, iy);
-  if ((p - p_W_start_).norm() <= params_.escape_radius_m) return true;
+  if (escape_ && (grid_.CellCenter(ix, iy) - p_W_start_).norm() <= params_.escape_radius_m) {
+    return true;
+  }
   return state == CellState::kFree && clearance_[grid_.Index(ix, iy)] >= params_.clearance_m;
+}
+
+bool NavigationMap::Comfortable(int ix, int iy) const {
+  return grid_.Contains(ix, iy) && grid_.State(ix, iy) == CellState::kFree &&
+         clearance_[grid_.Index(ix, iy)] >= params_.clearance_m;
 }
 
 bool NavigationMap::TraversableAt(const Eigen::Vector2d& p_W) const {

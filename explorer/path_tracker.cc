@@ -175,6 +175,8 @@ Twist2 SafetyFilter(const Twist2& command, const Pose2& X_WR,
                                                                      : params.safety_margin_m;
   const Twist2 candidates[] = {command,
                                {0.5 * command.v_mps, command.w_radps},
+                               {command.v_mps, 0.0},
+                               {0.5 * command.v_mps, 0.0},
                                {0.0, command.w_radps},
                                {0.0, 0.0}};
   if (limited != nullptr) *limited = false;
