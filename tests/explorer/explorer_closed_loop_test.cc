@@ -14,6 +14,7 @@
 #include "common/angles.h"
 #include "explorer/explorer.h"
 #include "tests/explorer/kinematic_sim.h"
+#include "tests/explorer/seen_area.h"
 
 namespace mjslam::explorer {
 namespace {
@@ -32,46 +33,6 @@ std::vector<Wall> TwoRooms() {
   return walls;
 }
 
-bool InsideColumn(const Eigen::Vector2d& p) {
-  return p.x() > 7.2 && p.x() < 7.8 && p.y() > 1.2 && p.y() < 1.8;
-}
-
-// Ground truth of what the laser has seen, on 0.1 m cells of the free area.
-class SeenArea {
- public:
-  SeenArea() : seen_(kWidth * kHeight, 0) {}
-  void Add(const LaserScan& scan, const Pose2& X_WS) {
-    for (int i = 0; i < scan.size(); ++i) {
-      const double th = X_WS.theta + scan.BeamAngle(i);
-      const Eigen::Vector2d u(std::cos(th), std::sin(th));
-      for (double s = 0.0; s <= scan.ranges_m[i]; s += 0.02) {
-        const Eigen::Vector2d p = X_WS.translation() + s * u;
-        const int ix = static_cast<int>(std::floor(p.x() / kCell));
-        const int iy = static_cast<int>(std::floor(p.y() / kCell));
-        if (ix >= 0 && iy >= 0 && ix < kWidth && iy < kHeight) seen_[iy * kWidth + ix] = 1;
-      }
-    }
-  }
-  double Fraction() const {
-    int total = 0;
-    int seen = 0;
-    for (int iy = 0; iy < kHeight; ++iy) {
-      for (int ix = 0; ix < kWidth; ++ix) {
-        if (InsideColumn({(ix + 0.5) * kCell, (iy + 0.5) * kCell})) continue;
-        ++total;
-        seen += seen_[iy * kWidth + ix];
-      }
-    }
-    return double(seen) / total;
-  }
-
- private:
-  static constexpr double kCell = 0.1;
-  static constexpr int kWidth = 100;
-  static constexpr int kHeight = 40;
-  std::vector<std::uint8_t> seen_;
-};
-
 struct EpisodeResult {
   double t_s = 0.0;
   double explored = 0.0;
@@ -86,7 +47,7 @@ EpisodeResult RunEpisode(const Pose2& X_WR0, double duration_s) {
   KinematicSim::Config config;
   KinematicSim sim(TwoRooms(), X_WR0, config);
   Explorer explorer(ExplorerParams{}, config.a_m);
-  SeenArea seen;
+  testing::SeenArea seen(TwoRooms(), X_WR0.translation());
   EpisodeResult result;
   const double dt = 0.1;
   for (double t = 0.0; t < duration_s; t += dt) {
