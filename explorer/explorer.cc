@@ -61,6 +61,20 @@ std::optional<Eigen::Vector2d> Explorer::goal() const {
   return goal_W_;
 }
 
+std::vector<ExplorerLogRow> Explorer::LogRows() const {
+  std::vector<ExplorerLogRow> rows;
+  for (size_t i = 0; i < frontier_points_.size(); ++i) {
+    rows.push_back({"frontier", static_cast<int>(i), frontier_points_[i].x(),
+                    frontier_points_[i].y()});
+  }
+  if (has_goal_) rows.push_back({"goal", 0, goal_W_.x(), goal_W_.y()});
+  const Path& path = tracker_.path();
+  for (size_t i = 0; i < path.size(); ++i) {
+    rows.push_back({"path", static_cast<int>(i), path[i].p_W.x(), path[i].p_W.y()});
+  }
+  return rows;
+}
+
 bool Explorer::Blacklisted(const Eigen::Vector2d& p_W, bool* failed) const {
   bool near = false;
   if (failed != nullptr) *failed = false;

@@ -31,6 +31,16 @@ struct ExplorerOutput {
   bool safety_active = false;
 };
 
+/// One row of explorer.csv (`t,kind,index,x,y`, without the time): kind
+/// "frontier" (candidate points), "goal" (one point) or "path" (points in
+/// order of `index`), position in W, metres.
+struct ExplorerLogRow {
+  const char* kind = "";
+  int index = 0;
+  double x_m = 0.0;
+  double y_m = 0.0;
+};
+
 /// The frontier explorer (method.md "The explorer"; the paper's ref. [10]):
 /// the one entry point the application calls at every control step.
 ///
@@ -72,6 +82,9 @@ class Explorer {
   /// Incremented whenever the frontier points, the goal or the path change:
   /// write explorer.csv rows when it differs from the last one written.
   int log_version() const { return log_version_; }
+  /// The current set as explorer.csv rows: frontier points, the goal (if
+  /// any), then the path points, each kind indexed from 0.
+  std::vector<ExplorerLogRow> LogRows() const;
 
   /// The occupancy grid built so far.
   const OccupancyGrid& grid() const { return grid_; }

@@ -74,7 +74,13 @@ class OccupancyGrid {
   /// Log-odds of a cell; 0 (unknown) outside the grid.
   double LogOdds(int ix, int iy) const;
   /// State of a cell from the thresholds; unknown outside the grid.
-  CellState State(int ix, int iy) const;
+  CellState State(int ix, int iy) const {
+    if (!Contains(ix, iy)) return CellState::kUnknown;
+    const double l = log_odds_[Index(ix, iy)];
+    if (l >= settings_.occupied_threshold) return CellState::kOccupied;
+    if (l <= settings_.free_threshold) return CellState::kFree;
+    return CellState::kUnknown;
+  }
   /// State of the cell containing `p_W`.
   CellState StateAt(const Eigen::Vector2d& p_W) const;
 

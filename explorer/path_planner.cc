@@ -116,6 +116,13 @@ NavigationMap::NavigationMap(const OccupancyGrid& grid, const ExplorerParams& pa
   // Dijkstra from the start cell, ties broken by cell index (deterministic).
   if (!grid_.Contains(start_.x(), start_.y())) return;
   escape_ = !Comfortable(start_.x(), start_.y());
+  traversable_.assign(n, 0);
+  for (int iy = 0; iy < h; ++iy) {
+    for (int ix = 0; ix < w; ++ix) traversable_[iy * w + ix] = TraversableSlow(ix, iy);
+  }
+  auto traversable = [&](int ix, int iy) {
+    return ix >= 0 && iy >= 0 && ix < w && iy < h && traversable_[iy * w + ix] != 0;
+  };
   const double r = grid_.resolution();
   using Entry = std::pair<double, int>;
   std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> open;
@@ -133,9 +140,9 @@ NavigationMap::NavigationMap(const OccupancyGrid& grid, const ExplorerParams& pa
     for (int k = 0; k < 8; ++k) {
       const int jx = ix + dx[k];
       const int jy = iy + dy[k];
-      if (!Traversable(jx, jy)) continue;
+      if (!traversable(jx, jy)) continue;
       // Diagonal moves must not cut the corner of a blocked cell.
-      if (k >= 4 && (!Traversable(ix + dx[k], iy) || !Traversable(ix, iy + dy[k]))) continue;
+      if (k >= 4 && (!traversable(ix + dx[k], iy) || !traversable(ix, iy + dy[k]))) continue;
       const int j = grid_.Index(jx, jy);
       const double shortfall =
           std::max(0.0, params_.preferred_clearance_m - clearance_[j]) /
@@ -162,6 +169,12 @@ double NavigationMap::ClearanceAt(const Eigen::Vector2d& p_W) const {
 }
 
 bool NavigationMap::Traversable(int ix, int iy) const {
+  if (!grid_.Contains(ix, iy)) return false;
+  if (!traversable_.empty()) return traversable_[grid_.Index(ix, iy)] != 0;
+  return TraversableSlow(ix, iy);
+}
+
+bool NavigationMap::TraversableSlow(int ix, int iy) const {
   if (!grid_.Contains(ix, iy)) return false;
   const CellState state = grid_.State(ix, iy);
   if (state == CellState::kOccupied) return false;

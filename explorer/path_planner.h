@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include <Eigen/Core>
@@ -68,6 +69,9 @@ class NavigationMap {
   Eigen::Vector2i start_cell() const { return start_; }
 
  private:
+  // Traversable() from the grid and the clearance.
+  bool TraversableSlow(int ix, int iy) const;
+
   const OccupancyGrid& grid_;
   ExplorerParams params_;
   Eigen::Vector2d p_W_start_;
@@ -75,6 +79,8 @@ class NavigationMap {
   // Whether the escape rule applies (the start lacks clearance).
   bool escape_ = false;
   std::vector<float> clearance_;
+  // Traversable() of every cell, computed once.
+  std::vector<std::uint8_t> traversable_;
   std::vector<double> cost_;
   std::vector<int> parent_;
 };

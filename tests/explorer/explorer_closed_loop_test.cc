@@ -90,6 +90,44 @@ TEST(ExplorerClosedLoopTest, ExploresTwoRoomsWithoutContact) {
   }
 }
 
+// The log rows follow the explorer's state: frontier points, the goal, the
+// path in order, and the version changes when they do.
+TEST(ExplorerClosedLoopTest, LogRowsDescribeTheCurrentSet) {
+  KinematicSim::Config config;
+  KinematicSim sim(TwoRooms(), Pose2(1.5, 1.0, 0.3), config);
+  ExplorerParams params;
+  params.initial_turn_deg = 0.0;
+  Explorer explorer(params, config.a_m);
+  const LaserScan scan = sim.Scan(0.0);
+  const int version = explorer.log_version();
+  explorer.Step(sim.X_WR(), &scan, config.X_RS, 0.0, 0.1);
+  EXPECT_NE(explorer.log_version(), version);
+  ASSERT_TRUE(explorer.goal().has_value());
+  const std::vector<ExplorerLogRow> rows = explorer.LogRows();
+  int frontiers = 0;
+  int goals = 0;
+  int path_points = 0;
+  for (const ExplorerLogRow& row : rows) {
+    const std::string kind = row.kind;
+    if (kind == "frontier") EXPECT_EQ(row.index, frontiers++);
+    if (kind == "goal") {
+      ++goals;
+      EXPECT_EQ(row.x_m, explorer.goal()->x());
+      EXPECT_EQ(row.y_m, explorer.goal()->y());
+    }
+    if (kind == "path") {
+      EXPECT_EQ(row.index, path_points);
+      EXPECT_EQ(row.x_m, explorer.path()[path_points].p_W.x());
+      ++path_points;
+    }
+  }
+  EXPECT_EQ(frontiers, static_cast<int>(explorer.frontier_points().size()));
+  EXPECT_GE(frontiers, 1);
+  EXPECT_EQ(goals, 1);
+  EXPECT_EQ(path_points, static_cast<int>(explorer.path().size()));
+  EXPECT_EQ(static_cast<int>(rows.size()), frontiers + goals + path_points);
+}
+
 // Same inputs, same commands, bit for bit.
 TEST(ExplorerClosedLoopTest, EpisodeIsDeterministic) {
   const EpisodeResult first = RunEpisode(Pose2(1.5, 1.0, 0.3), 30.0);
