@@ -12,6 +12,8 @@ namespace {
 // Margin added around the covered box when the grid grows, metres: growing by
 // chunks keeps the number of reallocations small.
 constexpr double kGrowthMarginM = 2.0;
+// Largest shortening of a beam's free part at grazing incidence, metres.
+constexpr double kMaxGrazingMarginM = 0.3;
 
 }  // namespace
 
@@ -141,10 +143,33 @@ void OccupancyGrid::InsertScan(const LaserScan& scan, const Pose2& X_WS) {
   // echo that is inserted as occupied.
   std::vector<double> free_range(n);
   std::vector<std::uint8_t> hit(n);
+  auto echo_at = [&](int i) {
+    return i >= 0 && i < n && scan.has_return[i] != 0 && scan.ranges_m[i] < scan.max_range_m;
+  };
   for (int i = 0; i < n; ++i) {
-    const bool echo = scan.has_return[i] != 0 && scan.ranges_m[i] < scan.max_range_m;
+    const bool echo = echo_at(i);
     if (echo && scan.ranges_m[i] <= settings_.max_insert_range_m) {
-      free_range[i] = std::max(0.0, scan.ranges_m[i] - 0.5 * r_cell);
+      // Stop short of the surface by more at grazing incidence, so that the
+      // beam does not run along the row of cells holding the wall and erase
+      // it: 0.7 cell across the surface, whose direction comes from the
+      // neighbouring echo at a similar range.
+      double margin = 0.5 * r_cell;
+      for (const int j : {i + 1, i - 1}) {
+        if (!echo_at(j) || std::abs(scan.ranges_m[j] - scan.ranges_m[i]) > 0.5) continue;
+        const double a_i = scan.BeamAngle(i);
+        const double a_j = scan.BeamAngle(j);
+        const Eigen::Vector2d u(std::cos(a_i), std::sin(a_i));
+        const Eigen::Vector2d tangent =
+            scan.ranges_m[j] * Eigen::Vector2d(std::cos(a_j), std::sin(a_j)) -
+            scan.ranges_m[i] * u;
+        if (tangent.norm() < 1e-9) break;
+        const double sin_incidence =
+            std::abs(u.x() * tangent.y() - u.y() * tangent.x()) / tangent.norm();
+        margin = std::max(margin, std::min(kMaxGrazingMarginM,
+                                           0.7 * r_cell / std::max(sin_incidence, 1e-3)));
+        break;
+      }
+      free_range[i] = std::max(0.0, scan.ranges_m[i] - margin);
       hit[i] = 1;
     } else if (echo) {
       free_range[i] = settings_.max_insert_range_m;

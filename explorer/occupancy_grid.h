@@ -33,7 +33,9 @@ enum class CellState : std::uint8_t { kUnknown = 0, kFree = 1, kOccupied = 2 };
 /// are) to cover every scan inserted, so no world bound is needed.
 ///
 /// Departures from the textbook model: each cell is updated at most once per
-/// scan; the free space between two consecutive beams is filled up to the
+/// scan; a beam's free part stops short of its echo by 0.7 cell across the
+/// surface (up to 0.3 m along a grazing beam), so that grazing beams do not
+/// erase the wall they run along; the free space between two consecutive beams is filled up to the
 /// shorter of the two ranges (sub-rays), so that far-away free space has no
 /// unknown holes between diverging beams; echoes beyond `max_insert_range_m`
 /// only clear free space up to that range, and no-return beams clear free

@@ -339,12 +339,29 @@ Path PlanPath(const NavigationMap& map, const ExplorerParams& params,
     points.push_back(grid.CellCenter(cells[i].x(), cells[i].y()));
   }
   if (points.size() == 1) points.push_back(points.front());
-  // Line-of-sight shortcuts.
+  // Line-of-sight shortcuts that keep the clearance the cell path had over
+  // the part they replace (less one cell): a shortcut must not hug the jamb
+  // of a door that the cell path passed in the middle.
+  std::vector<double> clearance(points.size());
+  for (size_t k = 0; k < points.size(); ++k) clearance[k] = map.ClearanceAt(points[k]);
+  auto shortcut_ok = [&](size_t from, size_t to) {
+    if (!map.SegmentTraversable(points[from], points[to])) return false;
+    double needed = params.preferred_clearance_m;
+    for (size_t k = from; k <= to; ++k) needed = std::min(needed, clearance[k]);
+    needed -= grid.resolution();
+    const double length = (points[to] - points[from]).norm();
+    const int n = std::max(1, static_cast<int>(std::ceil(length / (0.5 * grid.resolution()))));
+    for (int k = 0; k <= n; ++k) {
+      const Eigen::Vector2d p = points[from] + (double(k) / n) * (points[to] - points[from]);
+      if (map.ClearanceAt(p) < needed) return false;
+    }
+    return true;
+  };
   std::vector<Eigen::Vector2d> vertices = {points.front()};
   size_t i = 0;
   while (i + 1 < points.size()) {
     size_t j = i + 1;
-    while (j + 1 < points.size() && map.SegmentTraversable(points[i], points[j + 1])) ++j;
+    while (j + 1 < points.size() && shortcut_ok(i, j + 1)) ++j;
     vertices.push_back(points[j]);
     i = j;
   }
