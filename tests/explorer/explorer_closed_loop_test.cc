@@ -25,10 +25,10 @@ using testing::Wall;
 
 // The layout: rooms [0, 5] x [0, 4] and [5, 10] x [0, 4], a wall at x = 5
 // with a 1.2 m door at y in [2.4, 3.6], a 0.6 m column in the second room.
-std::vector<Wall> TwoRooms() {
+std::vector<Wall> TwoRooms(double door_width_m = 1.2) {
   std::vector<Wall> walls = Box(0.0, 0.0, 10.0, 4.0);
-  walls.push_back({{5.0, 0.0}, {5.0, 2.4}});
-  walls.push_back({{5.0, 3.6}, {5.0, 4.0}});
+  walls.push_back({{5.0, 0.0}, {5.0, 3.0 - 0.5 * door_width_m}});
+  walls.push_back({{5.0, 3.0 + 0.5 * door_width_m}, {5.0, 4.0}});
   for (const Wall& wall : Box(7.2, 1.2, 7.8, 1.8)) walls.push_back(wall);
   return walls;
 }
@@ -43,9 +43,9 @@ struct EpisodeResult {
   std::vector<double> commands;
 };
 
-EpisodeResult RunEpisode(const Pose2& X_WR0, double duration_s) {
+EpisodeResult RunEpisode(const Pose2& X_WR0, double duration_s, double door_width_m = 1.2) {
   KinematicSim::Config config;
-  KinematicSim sim(TwoRooms(), X_WR0, config);
+  KinematicSim sim(TwoRooms(door_width_m), X_WR0, config);
   Explorer explorer(ExplorerParams{}, config.a_m);
   testing::SeenArea seen(TwoRooms(), X_WR0.translation());
   EpisodeResult result;
@@ -88,6 +88,24 @@ TEST(ExplorerClosedLoopTest, ExploresTwoRoomsWithoutContact) {
     EXPECT_GE(result.explored, 0.95);
     EXPECT_EQ(result.contacts, 0);
   }
+}
+
+// A door too narrow for the robot (0.7 m: the body is 0.38 m wide but the
+// paths keep 0.5 m clearance): the explorer explores its own room, does not
+// circle in front of the door, and ends with `unreachable` well before the
+// time limit.
+TEST(ExplorerClosedLoopTest, EndsUnreachableBehindANarrowDoor) {
+  const EpisodeResult result = RunEpisode(Pose2(1.5, 1.0, 0.3), 600.0, 0.7);
+  std::printf("narrow door: finished %d (%s) at t = %.1f s, explored %.3f, contacts %d\n",
+              result.finished, result.reason.c_str(), result.t_s, result.explored,
+              result.contacts);
+  EXPECT_TRUE(result.finished);
+  EXPECT_EQ(result.reason, "unreachable");
+  EXPECT_LT(result.t_s, 300.0);
+  EXPECT_EQ(result.contacts, 0);
+  // The first room (half the area) is seen, and some of the second
+  // through the door.
+  EXPECT_GT(result.explored, 0.5);
 }
 
 // The log rows follow the explorer's state: frontier points, the goal, the
