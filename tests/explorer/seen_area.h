@@ -81,7 +81,7 @@ class SeenArea {
     for (int i = 0; i < scan.size(); ++i) {
       const double th = X_WS.theta + scan.BeamAngle(i);
       const Eigen::Vector2d u(std::cos(th), std::sin(th));
-      for (double s = 0.0; s <= scan.ranges_m[i]; s += 0.02) {
+      for (double s = 0.0; s <= scan.ranges_m[i]; s += 0.04) {
         const Eigen::Vector2d p = X_WS.translation() + s * u;
         const int ix = CellX(p.x());
         const int iy = CellY(p.y());
