@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "common/angles.h"
+#include "common/check.h"
 #include "explorer/frontiers.h"
 #include "explorer/point_h_controller.h"
 
@@ -219,6 +220,7 @@ void Explorer::ChooseGoal(const Pose2& X_WR, double t_s) {
 
 ExplorerOutput Explorer::Step(const Pose2& X_WR, const LaserScan* scan, const Pose2& X_RS,
                               double t_s, double dt_s) {
+  MJSLAM_CHECK(dt_s > 0.0);
   ExplorerOutput output;
   // The map and the scan's frontier points.
   if (scan != nullptr) {

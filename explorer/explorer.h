@@ -69,7 +69,8 @@ class Explorer {
   /// One control step. `X_WR`: the pose estimate of R (the point h) in W;
   /// `scan`: a new sweep or nullptr; `X_RS`: the laser mount (pose of S in R);
   /// `t_s`: time since the start; `dt_s` > 0: how long the command will be
-  /// held (the control period).
+  /// held (the control period; checked, a broken invariant aborts). Between
+  /// scans (`scan` null) it keeps using the last scan.
   ExplorerOutput Step(const Pose2& X_WR, const LaserScan* scan, const Pose2& X_RS, double t_s,
                       double dt_s);
 

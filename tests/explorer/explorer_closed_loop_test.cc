@@ -126,7 +126,10 @@ TEST(ExplorerClosedLoopTest, LogRowsDescribeTheCurrentSet) {
   int path_points = 0;
   for (const ExplorerLogRow& row : rows) {
     const std::string kind = row.kind;
-    if (kind == "frontier") EXPECT_EQ(row.index, frontiers++);
+    if (kind == "frontier") {
+      EXPECT_EQ(row.index, frontiers);
+      ++frontiers;
+    }
     if (kind == "goal") {
       ++goals;
       EXPECT_EQ(row.x_m, explorer.goal()->x());
