@@ -86,14 +86,14 @@ class OccupancyGrid {
   /// State of the cell containing `p_W`.
   CellState StateAt(const Eigen::Vector2d& p_W) const;
 
-  /// Area of the cells in each state, m^2 (for reports and tests).
+  /// Area of the known-free cells, m^2 (for reports and tests).
   double KnownFreeArea() const;
 
  private:
   // Grows the grid so that it covers the axis-aligned box [lo, hi] (world).
   void EnsureCovers(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi);
-  // Marks the cells along the ray from `from` to `to` (excluding the cell of
-  // `to` when `exclude_end`) for a free update in this scan.
+  // Marks every cell the segment from `from` to `to` crosses (both ends
+  // included) for a free update in this scan.
   void MarkRayFree(const Eigen::Vector2d& from, const Eigen::Vector2d& to);
   // Applies the marks of this scan and clears them.
   void ApplyMarks();

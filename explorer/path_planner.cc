@@ -299,7 +299,7 @@ Path SmoothPolyline(const std::vector<Eigen::Vector2d>& vertices, const Navigati
     last.heading_rad = std::atan2(u.y(), u.x());
   }
   path.push_back(last);
-  // Remove a stop-and-turn point that duplicates the previous point.
+  // Arc length.
   for (size_t i = 1; i < path.size(); ++i) {
     path[i].s_m = path[i - 1].s_m + (path[i].p_W - path[i - 1].p_W).norm();
   }
