@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "common/angles.h"
+#include "common/check.h"
 #include "explorer/frontiers.h"
 #include "explorer/point_h_controller.h"
 
@@ -59,6 +60,20 @@ Explorer::Explorer(const ExplorerParams& params, double a_m)
 std::optional<Eigen::Vector2d> Explorer::goal() const {
   if (!has_goal_) return std::nullopt;
   return goal_W_;
+}
+
+std::vector<ExplorerLogRow> Explorer::LogRows() const {
+  std::vector<ExplorerLogRow> rows;
+  for (size_t i = 0; i < frontier_points_.size(); ++i) {
+    rows.push_back({"frontier", static_cast<int>(i), frontier_points_[i].x(),
+                    frontier_points_[i].y()});
+  }
+  if (has_goal_) rows.push_back({"goal", 0, goal_W_.x(), goal_W_.y()});
+  const Path& path = tracker_.path();
+  for (size_t i = 0; i < path.size(); ++i) {
+    rows.push_back({"path", static_cast<int>(i), path[i].p_W.x(), path[i].p_W.y()});
+  }
+  return rows;
 }
 
 bool Explorer::Blacklisted(const Eigen::Vector2d& p_W, bool* failed) const {
@@ -154,7 +169,7 @@ void Explorer::ChooseGoal(const Pose2& X_WR, double t_s) {
       for (int iy = c.y() - window; iy <= c.y() + window; ++iy) {
         for (int ix = c.x() - window; ix <= c.x() + window; ++ix) {
           const double cost = map.CostTo(ix, iy);
-          if (!std::isfinite(cost)) continue;
+          if (!std::isfinite(cost) || !map.Comfortable(ix, iy)) continue;
           const Eigen::Vector2d cell = grid_.CellCenter(ix, iy);
           const double distance = (cell - p).norm();
           if (distance > params_.view_distance_m) continue;
@@ -205,6 +220,7 @@ void Explorer::ChooseGoal(const Pose2& X_WR, double t_s) {
 
 ExplorerOutput Explorer::Step(const Pose2& X_WR, const LaserScan* scan, const Pose2& X_RS,
                               double t_s, double dt_s) {
+  MJSLAM_CHECK(dt_s > 0.0);
   ExplorerOutput output;
   // The map and the scan's frontier points.
   if (scan != nullptr) {

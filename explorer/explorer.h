@@ -31,6 +31,16 @@ struct ExplorerOutput {
   bool safety_active = false;
 };
 
+/// One row of explorer.csv (`t,kind,index,x,y`, without the time): kind
+/// "frontier" (candidate points), "goal" (one point) or "path" (points in
+/// order of `index`), position in W, metres.
+struct ExplorerLogRow {
+  const char* kind = "";
+  int index = 0;
+  double x_m = 0.0;
+  double y_m = 0.0;
+};
+
 /// The frontier explorer (method.md "The explorer"; the paper's ref. [10]):
 /// the one entry point the application calls at every control step.
 ///
@@ -59,7 +69,8 @@ class Explorer {
   /// One control step. `X_WR`: the pose estimate of R (the point h) in W;
   /// `scan`: a new sweep or nullptr; `X_RS`: the laser mount (pose of S in R);
   /// `t_s`: time since the start; `dt_s` > 0: how long the command will be
-  /// held (the control period).
+  /// held (the control period; checked, a broken invariant aborts). Between
+  /// scans (`scan` null) it keeps using the last scan.
   ExplorerOutput Step(const Pose2& X_WR, const LaserScan* scan, const Pose2& X_RS, double t_s,
                       double dt_s);
 
@@ -72,6 +83,9 @@ class Explorer {
   /// Incremented whenever the frontier points, the goal or the path change:
   /// write explorer.csv rows when it differs from the last one written.
   int log_version() const { return log_version_; }
+  /// The current set as explorer.csv rows: frontier points, the goal (if
+  /// any), then the path points, each kind indexed from 0.
+  std::vector<ExplorerLogRow> LogRows() const;
 
   /// The occupancy grid built so far.
   const OccupancyGrid& grid() const { return grid_; }

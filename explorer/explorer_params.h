@@ -86,7 +86,7 @@ struct ExplorerParams {
   double progress_timeout_s = 12.0;
   double progress_min_m = 0.3;
   /// A goal fails when the safety layer blocks the robot this long, seconds.
-  double blocked_timeout_s = 3.0;
+  double blocked_timeout_s = 6.0;
   /// Frontier points within this distance of a failed or reached goal are
   /// skipped, metres.
   double blacklist_radius_m = 0.6;

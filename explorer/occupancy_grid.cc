@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "common/check.h"
 
@@ -11,6 +12,8 @@ namespace {
 // Margin added around the covered box when the grid grows, metres: growing by
 // chunks keeps the number of reallocations small.
 constexpr double kGrowthMarginM = 2.0;
+// Largest shortening of a beam's free part at grazing incidence, metres.
+constexpr double kMaxGrazingMarginM = 0.3;
 
 }  // namespace
 
@@ -29,14 +32,6 @@ Eigen::Vector2d OccupancyGrid::CellCenter(int ix, int iy) const {
 
 double OccupancyGrid::LogOdds(int ix, int iy) const {
   return Contains(ix, iy) ? log_odds_[Index(ix, iy)] : 0.0;
-}
-
-CellState OccupancyGrid::State(int ix, int iy) const {
-  if (!Contains(ix, iy)) return CellState::kUnknown;
-  const double l = log_odds_[Index(ix, iy)];
-  if (l >= settings_.occupied_threshold) return CellState::kOccupied;
-  if (l <= settings_.free_threshold) return CellState::kFree;
-  return CellState::kUnknown;
 }
 
 CellState OccupancyGrid::StateAt(const Eigen::Vector2d& p_W) const {
@@ -92,18 +87,40 @@ void OccupancyGrid::EnsureCovers(const Eigen::Vector2d& lo, const Eigen::Vector2
 }
 
 void OccupancyGrid::MarkRayFree(const Eigen::Vector2d& from, const Eigen::Vector2d& to) {
-  // Samples at half a cell: every cell the ray crosses for more than a
-  // sliver is visited.
-  const double length = (to - from).norm();
-  const int steps = static_cast<int>(std::ceil(length / (0.5 * settings_.resolution_m)));
-  for (int k = 0; k <= steps; ++k) {
-    const Eigen::Vector2d p = from + (steps == 0 ? 0.0 : double(k) / steps) * (to - from);
-    const Eigen::Vector2i c = CellOf(p);
-    if (!Contains(c.x(), c.y())) continue;
-    const int i = Index(c.x(), c.y());
-    if (marks_[i] == 0) {
-      marks_[i] = 1;
-      touched_.push_back(i);
+  // Every cell the segment crosses, once (Amanatides and Woo, "A Fast Voxel
+  // Traversal Algorithm", 1987).
+  const double r = settings_.resolution_m;
+  Eigen::Vector2i cell = CellOf(from);
+  const Eigen::Vector2i last = CellOf(to);
+  const Eigen::Vector2d d = to - from;
+  const int step_x = d.x() > 0 ? 1 : -1;
+  const int step_y = d.y() > 0 ? 1 : -1;
+  const double inf = std::numeric_limits<double>::infinity();
+  const double delta_x = d.x() != 0.0 ? r / std::abs(d.x()) : inf;
+  const double delta_y = d.y() != 0.0 ? r / std::abs(d.y()) : inf;
+  const Eigen::Vector2d corner = origin_ + r * cell.cast<double>();
+  double t_x = d.x() != 0.0
+                   ? ((d.x() > 0 ? corner.x() + r : corner.x()) - from.x()) / d.x()
+                   : inf;
+  double t_y = d.y() != 0.0
+                   ? ((d.y() > 0 ? corner.y() + r : corner.y()) - from.y()) / d.y()
+                   : inf;
+  const int max_steps = std::abs(last.x() - cell.x()) + std::abs(last.y() - cell.y());
+  for (int k = 0; k <= max_steps; ++k) {
+    if (Contains(cell.x(), cell.y())) {
+      const int i = Index(cell.x(), cell.y());
+      if (marks_[i] == 0) {
+        marks_[i] = 1;
+        touched_.push_back(i);
+      }
+    }
+    if (cell == last) break;
+    if (t_x < t_y) {
+      cell.x() += step_x;
+      t_x += delta_x;
+    } else {
+      cell.y() += step_y;
+      t_y += delta_y;
     }
   }
 }
@@ -126,10 +143,33 @@ void OccupancyGrid::InsertScan(const LaserScan& scan, const Pose2& X_WS) {
   // echo that is inserted as occupied.
   std::vector<double> free_range(n);
   std::vector<std::uint8_t> hit(n);
+  auto echo_at = [&](int i) {
+    return i >= 0 && i < n && scan.has_return[i] != 0 && scan.ranges_m[i] < scan.max_range_m;
+  };
   for (int i = 0; i < n; ++i) {
-    const bool echo = scan.has_return[i] != 0 && scan.ranges_m[i] < scan.max_range_m;
+    const bool echo = echo_at(i);
     if (echo && scan.ranges_m[i] <= settings_.max_insert_range_m) {
-      free_range[i] = std::max(0.0, scan.ranges_m[i] - 0.5 * r_cell);
+      // Stop short of the surface by more at grazing incidence, so that the
+      // beam does not run along the row of cells holding the wall and erase
+      // it: 0.7 cell across the surface, whose direction comes from the
+      // neighbouring echo at a similar range.
+      double margin = 0.5 * r_cell;
+      for (const int j : {i + 1, i - 1}) {
+        if (!echo_at(j) || std::abs(scan.ranges_m[j] - scan.ranges_m[i]) > 0.5) continue;
+        const double a_i = scan.BeamAngle(i);
+        const double a_j = scan.BeamAngle(j);
+        const Eigen::Vector2d u(std::cos(a_i), std::sin(a_i));
+        const Eigen::Vector2d tangent =
+            scan.ranges_m[j] * Eigen::Vector2d(std::cos(a_j), std::sin(a_j)) -
+            scan.ranges_m[i] * u;
+        if (tangent.norm() < 1e-9) break;
+        const double sin_incidence =
+            std::abs(u.x() * tangent.y() - u.y() * tangent.x()) / tangent.norm();
+        margin = std::max(margin, std::min(kMaxGrazingMarginM,
+                                           0.7 * r_cell / std::max(sin_incidence, 1e-3)));
+        break;
+      }
+      free_range[i] = std::max(0.0, scan.ranges_m[i] - margin);
       hit[i] = 1;
     } else if (echo) {
       free_range[i] = settings_.max_insert_range_m;

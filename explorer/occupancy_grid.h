@@ -33,7 +33,9 @@ enum class CellState : std::uint8_t { kUnknown = 0, kFree = 1, kOccupied = 2 };
 /// are) to cover every scan inserted, so no world bound is needed.
 ///
 /// Departures from the textbook model: each cell is updated at most once per
-/// scan; the free space between two consecutive beams is filled up to the
+/// scan; a beam's free part stops short of its echo by 0.7 cell across the
+/// surface (up to 0.3 m along a grazing beam), so that grazing beams do not
+/// erase the wall they run along; the free space between two consecutive beams is filled up to the
 /// shorter of the two ranges (sub-rays), so that far-away free space has no
 /// unknown holes between diverging beams; echoes beyond `max_insert_range_m`
 /// only clear free space up to that range, and no-return beams clear free
@@ -74,18 +76,24 @@ class OccupancyGrid {
   /// Log-odds of a cell; 0 (unknown) outside the grid.
   double LogOdds(int ix, int iy) const;
   /// State of a cell from the thresholds; unknown outside the grid.
-  CellState State(int ix, int iy) const;
+  CellState State(int ix, int iy) const {
+    if (!Contains(ix, iy)) return CellState::kUnknown;
+    const double l = log_odds_[Index(ix, iy)];
+    if (l >= settings_.occupied_threshold) return CellState::kOccupied;
+    if (l <= settings_.free_threshold) return CellState::kFree;
+    return CellState::kUnknown;
+  }
   /// State of the cell containing `p_W`.
   CellState StateAt(const Eigen::Vector2d& p_W) const;
 
-  /// Area of the cells in each state, m^2 (for reports and tests).
+  /// Area of the known-free cells, m^2 (for reports and tests).
   double KnownFreeArea() const;
 
  private:
   // Grows the grid so that it covers the axis-aligned box [lo, hi] (world).
   void EnsureCovers(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi);
-  // Marks the cells along the ray from `from` to `to` (excluding the cell of
-  // `to` when `exclude_end`) for a free update in this scan.
+  // Marks every cell the segment from `from` to `to` crosses (both ends
+  // included) for a free update in this scan.
   void MarkRayFree(const Eigen::Vector2d& from, const Eigen::Vector2d& to);
   // Applies the marks of this scan and clears them.
   void ApplyMarks();

@@ -83,7 +83,7 @@ NavigationMap::NavigationMap(const OccupancyGrid& grid, const ExplorerParams& pa
   const int h = grid_.height();
   const int n = w * h;
   clearance_.assign(n, 0.0f);
-  cost_.assign(n, std::numeric_limits<float>::infinity());
+  cost_.assign(n, kInfinity);
   parent_.assign(n, -1);
   if (n == 0) return;
 
@@ -115,11 +115,19 @@ NavigationMap::NavigationMap(const OccupancyGrid& grid, const ExplorerParams& pa
 
   // Dijkstra from the start cell, ties broken by cell index (deterministic).
   if (!grid_.Contains(start_.x(), start_.y())) return;
+  escape_ = !Comfortable(start_.x(), start_.y());
+  traversable_.assign(n, 0);
+  for (int iy = 0; iy < h; ++iy) {
+    for (int ix = 0; ix < w; ++ix) traversable_[iy * w + ix] = TraversableSlow(ix, iy);
+  }
+  auto traversable = [&](int ix, int iy) {
+    return ix >= 0 && iy >= 0 && ix < w && iy < h && traversable_[iy * w + ix] != 0;
+  };
   const double r = grid_.resolution();
   using Entry = std::pair<double, int>;
   std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> open;
   const int start_index = grid_.Index(start_.x(), start_.y());
-  cost_[start_index] = 0.0f;
+  cost_[start_index] = 0.0;
   open.push({0.0, start_index});
   const int dx[8] = {1, -1, 0, 0, 1, 1, -1, -1};
   const int dy[8] = {0, 0, 1, -1, 1, -1, 1, -1};
@@ -132,9 +140,9 @@ NavigationMap::NavigationMap(const OccupancyGrid& grid, const ExplorerParams& pa
     for (int k = 0; k < 8; ++k) {
       const int jx = ix + dx[k];
       const int jy = iy + dy[k];
-      if (!Traversable(jx, jy)) continue;
+      if (!traversable(jx, jy)) continue;
       // Diagonal moves must not cut the corner of a blocked cell.
-      if (k >= 4 && (!Traversable(ix + dx[k], iy) || !Traversable(ix, iy + dy[k]))) continue;
+      if (k >= 4 && (!traversable(ix + dx[k], iy) || !traversable(ix, iy + dy[k]))) continue;
       const int j = grid_.Index(jx, jy);
       const double shortfall =
           std::max(0.0, params_.preferred_clearance_m - clearance_[j]) /
@@ -164,11 +172,23 @@ double NavigationMap::ClearanceAt(const Eigen::Vector2d& p_W) const {
 
 bool NavigationMap::Traversable(int ix, int iy) const {
   if (!grid_.Contains(ix, iy)) return false;
+  if (!traversable_.empty()) return traversable_[grid_.Index(ix, iy)] != 0;
+  return TraversableSlow(ix, iy);
+}
+
+bool NavigationMap::TraversableSlow(int ix, int iy) const {
+  if (!grid_.Contains(ix, iy)) return false;
   const CellState state = grid_.State(ix, iy);
   if (state == CellState::kOccupied) return false;
-  const Eigen::Vector2d p = grid_.CellCenter(ix, iy);
-  if ((p - p_W_start_).norm() <= params_.escape_radius_m) return true;
+  if (escape_ && (grid_.CellCenter(ix, iy) - p_W_start_).norm() <= params_.escape_radius_m) {
+    return true;
+  }
   return state == CellState::kFree && clearance_[grid_.Index(ix, iy)] >= params_.clearance_m;
+}
+
+bool NavigationMap::Comfortable(int ix, int iy) const {
+  return grid_.Contains(ix, iy) && grid_.State(ix, iy) == CellState::kFree &&
+         clearance_[grid_.Index(ix, iy)] >= params_.clearance_m;
 }
 
 bool NavigationMap::TraversableAt(const Eigen::Vector2d& p_W) const {
@@ -281,7 +301,7 @@ Path SmoothPolyline(const std::vector<Eigen::Vector2d>& vertices, const Navigati
     last.heading_rad = std::atan2(u.y(), u.x());
   }
   path.push_back(last);
-  // Remove a stop-and-turn point that duplicates the previous point.
+  // Arc length.
   for (size_t i = 1; i < path.size(); ++i) {
     path[i].s_m = path[i - 1].s_m + (path[i].p_W - path[i - 1].p_W).norm();
   }
@@ -321,12 +341,29 @@ Path PlanPath(const NavigationMap& map, const ExplorerParams& params,
     points.push_back(grid.CellCenter(cells[i].x(), cells[i].y()));
   }
   if (points.size() == 1) points.push_back(points.front());
-  // Line-of-sight shortcuts.
+  // Line-of-sight shortcuts that keep the clearance the cell path had over
+  // the part they replace (less one cell): a shortcut must not hug the jamb
+  // of a door that the cell path passed in the middle.
+  std::vector<double> clearance(points.size());
+  for (size_t k = 0; k < points.size(); ++k) clearance[k] = map.ClearanceAt(points[k]);
+  auto shortcut_ok = [&](size_t from, size_t to) {
+    if (!map.SegmentTraversable(points[from], points[to])) return false;
+    double needed = params.preferred_clearance_m;
+    for (size_t k = from; k <= to; ++k) needed = std::min(needed, clearance[k]);
+    needed -= grid.resolution();
+    const double length = (points[to] - points[from]).norm();
+    const int n = std::max(1, static_cast<int>(std::ceil(length / (0.5 * grid.resolution()))));
+    for (int k = 0; k <= n; ++k) {
+      const Eigen::Vector2d p = points[from] + (double(k) / n) * (points[to] - points[from]);
+      if (map.ClearanceAt(p) < needed) return false;
+    }
+    return true;
+  };
   std::vector<Eigen::Vector2d> vertices = {points.front()};
   size_t i = 0;
   while (i + 1 < points.size()) {
     size_t j = i + 1;
-    while (j + 1 < points.size() && map.SegmentTraversable(points[i], points[j + 1])) ++j;
+    while (j + 1 < points.size() && shortcut_ok(i, j + 1)) ++j;
     vertices.push_back(points[j]);
     i = j;
   }

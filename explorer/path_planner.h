@@ -1,5 +1,6 @@
 #pragma once
 
+#include <cstdint>
 #include <vector>
 
 #include <Eigen/Core>
@@ -35,9 +36,10 @@ using Path = std::vector<PathPoint>;
 /// 2012) and the cost to reach every cell from a start point (Dijkstra,
 /// 8-connected, on known-free cells with at least `clearance_m`; each step
 /// costs its length times 1 + `clearance_cost_weight` * the shortfall of
-/// clearance below `preferred_clearance_m`, relative). Cells within
-/// `escape_radius_m` of the start need only be not occupied, so that a robot
-/// stopped close to a wall can plan its way out.
+/// clearance below `preferred_clearance_m`, relative). When the start cell
+/// itself lacks that clearance, cells within `escape_radius_m` of the start
+/// need only be not occupied, so that a robot stopped close to a wall can
+/// plan its way out.
 class NavigationMap {
  public:
   /// Builds the map of `grid` (which must outlive it) from `p_W_start`.
@@ -54,6 +56,9 @@ class NavigationMap {
   bool Traversable(int ix, int iy) const;
   /// Whether h may stand at the world point.
   bool TraversableAt(const Eigen::Vector2d& p_W) const;
+  /// Whether the cell is known free with at least `clearance_m` (a goal must
+  /// be; the escape rule does not apply).
+  bool Comfortable(int ix, int iy) const;
   /// Path cost from the start to the cell, metres (infinity if unreachable).
   double CostTo(int ix, int iy) const;
   /// Whether every point of the segment is traversable (sampled at half a cell).
@@ -64,12 +69,19 @@ class NavigationMap {
   Eigen::Vector2i start_cell() const { return start_; }
 
  private:
+  // Traversable() from the grid and the clearance.
+  bool TraversableSlow(int ix, int iy) const;
+
   const OccupancyGrid& grid_;
   ExplorerParams params_;
   Eigen::Vector2d p_W_start_;
   Eigen::Vector2i start_;
+  // Whether the escape rule applies (the start lacks clearance).
+  bool escape_ = false;
   std::vector<float> clearance_;
-  std::vector<float> cost_;
+  // Traversable() of every cell, computed once.
+  std::vector<std::uint8_t> traversable_;
+  std::vector<double> cost_;
   std::vector<int> parent_;
 };
 

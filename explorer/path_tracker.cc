@@ -70,10 +70,10 @@ Twist2 PathTracker::Command(const Pose2& X_WR, double dt_s) {
       // Turning in place at a stop point.
       const double error = WrapAngle(path_[turning_at_].heading_rad - X_WR.theta);
       if (std::abs(error) < kTurnDoneRad) {
+        // A stop point is passed once: clear its flag and move past it.
+        path_[turning_at_].turn_in_place = false;
         index_ = std::min(n - 1, turning_at_ + 1);
         turning_at_ = -1;
-        // A stop point is passed once; clear its flag.
-        path_[index_ - 1 >= 0 ? index_ - 1 : 0].turn_in_place = false;
       } else {
         desired.w_radps = params_.turn_gain_per_s * error;
       }
@@ -175,6 +175,8 @@ Twist2 SafetyFilter(const Twist2& command, const Pose2& X_WR,
                                                                      : params.safety_margin_m;
   const Twist2 candidates[] = {command,
                                {0.5 * command.v_mps, command.w_radps},
+                               {command.v_mps, 0.0},
+                               {0.5 * command.v_mps, 0.0},
                                {0.0, command.w_radps},
                                {0.0, 0.0}};
   if (limited != nullptr) *limited = false;

@@ -57,8 +57,8 @@ class PathTracker {
 /// held for `dt_s` and then braking at `brake_decel_mps2` (the yaw rate
 /// braking in proportion), and checks it against `obstacles_W` (scan echoes
 /// and occupied cells near the robot). When the prediction touches an
-/// obstacle it tries the command with half, then no, forward speed, then a
-/// full stop. When the body is already within the margin of an obstacle,
+/// obstacle it tries, in order, half the speed, no turn, half the speed and
+/// no turn, turning in place, a full stop. When the body is already within the margin of an obstacle,
 /// only actual contact is checked, so the robot can still move away.
 /// `a_m` is the offset of h ahead of the axle; `limited` (optional) tells
 /// whether the command was changed.

@@ -49,7 +49,9 @@ void ExpectFeasible(const Path& path, const ExplorerParams& params) {
               params.max_angular_speed_radps + 1e-9) << i;
     EXPECT_LE(p.speed_mps * p.speed_mps * std::abs(p.curvature_per_m),
               params.max_lateral_accel_mps2 + 1e-9) << i;
-    if (p.turn_in_place) EXPECT_EQ(p.speed_mps, 0.0) << i;
+    if (p.turn_in_place) {
+      EXPECT_EQ(p.speed_mps, 0.0) << i;
+    }
     if (i == 0) continue;
     const double ds = p.s_m - path[i - 1].s_m;
     EXPECT_LE(ds, params.path_step_m + 1e-9) << i;
