@@ -254,7 +254,7 @@ Map BuildGroundTruthMap(const std::vector<WallRectangle>& walls, const GroundTru
       r = -r;
       n = -n;
     }
-    line.params = {r, WrapAngle(std::atan2(n.y(), n.x()))};
+    line.params = {r, WrapAngle(std::atan2(n.y(), n.x())) + 0.0};  // no -0
     line.has_segment = true;
     line.p_WA = s.a;
     line.p_WB = s.b;
@@ -267,9 +267,91 @@ Map BuildGroundTruthMap(const std::vector<WallRectangle>& walls, const GroundTru
     corner.params = c.p;
     corner.corner_kind = c.convex ? MapFeature::CornerKind::kConvex
                                   : MapFeature::CornerKind::kConcave;
+    corner.free_direction_W = (segments[c.incoming].n + segments[c.outgoing].n).normalized();
     map.push_back(corner);
   }
   return map;
+}
+
+Map ReachableFeatures(const Map& truth, const std::vector<WallRectangle>& walls,
+                      const Eigen::Vector2d& p_W_start, double cell_m) {
+  if (!(cell_m > 0.0)) {
+    throw std::invalid_argument("reachable features: cell size must be > 0 (got " +
+                                ValueText(cell_m) + ")");
+  }
+  std::vector<Rectangle> rects;
+  for (std::size_t i = 0; i < walls.size(); ++i) {
+    rects.push_back(MakeRectangle(walls[i], static_cast<int>(i), 1e-9));
+  }
+  // The grid covers the walls, the start and the features, plus a margin
+  // of two cells, so that the outside of a building is connected around it.
+  Eigen::Vector2d lo = p_W_start;
+  Eigen::Vector2d hi = p_W_start;
+  for (const Rectangle& r : rects) {
+    for (const Eigen::Vector2d& c : r.corners) {
+      lo = lo.cwiseMin(c);
+      hi = hi.cwiseMax(c);
+    }
+  }
+  lo.array() -= 2.0 * cell_m;
+  hi.array() += 2.0 * cell_m;
+  const int nx = static_cast<int>(std::ceil((hi.x() - lo.x()) / cell_m));
+  const int ny = static_cast<int>(std::ceil((hi.y() - lo.y()) / cell_m));
+  auto index_of = [&](const Eigen::Vector2d& p, int* ix, int* iy) {
+    *ix = static_cast<int>(std::floor((p.x() - lo.x()) / cell_m));
+    *iy = static_cast<int>(std::floor((p.y() - lo.y()) / cell_m));
+    return *ix >= 0 && *iy >= 0 && *ix < nx && *iy < ny;
+  };
+  auto free_cell = [&](int ix, int iy) {
+    const Eigen::Vector2d centre(lo.x() + (ix + 0.5) * cell_m, lo.y() + (iy + 0.5) * cell_m);
+    for (const Rectangle& r : rects) {
+      if (r.Contains(centre, 0.0)) return false;
+    }
+    return true;
+  };
+  int sx = 0;
+  int sy = 0;
+  index_of(p_W_start, &sx, &sy);
+  if (!free_cell(sx, sy)) {
+    throw std::invalid_argument("reachable features: the start point (" +
+                                ValueText(p_W_start.x()) + ", " + ValueText(p_W_start.y()) +
+                                ") is inside a wall");
+  }
+  // Flood fill, 4-connected.
+  std::vector<char> reached(static_cast<std::size_t>(nx) * ny, 0);
+  std::vector<std::pair<int, int>> stack = {{sx, sy}};
+  reached[static_cast<std::size_t>(sy) * nx + sx] = 1;
+  while (!stack.empty()) {
+    const auto [x, y] = stack.back();
+    stack.pop_back();
+    const int next[4][2] = {{x + 1, y}, {x - 1, y}, {x, y + 1}, {x, y - 1}};
+    for (const auto& n : next) {
+      if (n[0] < 0 || n[1] < 0 || n[0] >= nx || n[1] >= ny) continue;
+      char& r = reached[static_cast<std::size_t>(n[1]) * nx + n[0]];
+      if (r != 0 || !free_cell(n[0], n[1])) continue;
+      r = 1;
+      stack.push_back({n[0], n[1]});
+    }
+  }
+  auto reachable = [&](const Eigen::Vector2d& p) {
+    int ix = 0;
+    int iy = 0;
+    return index_of(p, &ix, &iy) && reached[static_cast<std::size_t>(iy) * nx + ix] != 0;
+  };
+  Map kept;
+  for (const MapFeature& f : truth) {
+    Eigen::Vector2d probe;
+    if (f.type == MapFeature::Type::kLine) {
+      const Eigen::Vector2d d = (f.p_WB - f.p_WA).normalized();
+      probe = 0.5 * (f.p_WA + f.p_WB) + 1.5 * cell_m * Eigen::Vector2d(d.y(), -d.x());
+    } else {
+      probe = f.params + 1.5 * cell_m * f.free_direction_W;
+    }
+    if (!reachable(probe)) continue;
+    kept.push_back(f);
+    kept.back().id = static_cast<int>(kept.size()) - 1;
+  }
+  return kept;
 }
 
 }  // namespace mjslam::eval

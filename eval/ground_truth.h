@@ -54,4 +54,16 @@ struct GroundTruthParams {
 Map BuildGroundTruthMap(const std::vector<WallRectangle>& walls,
                         const GroundTruthParams& params = {});
 
+/// The features of `truth` (from BuildGroundTruthMap of `walls`) that face the
+/// free space reachable from p_W_start: a flood fill over a grid of
+/// `cell_m` cells (a cell is free when its centre is in no wall) from the
+/// cell of p_W_start; a line is kept when the point 1.5 cells off its
+/// segment's midpoint on the free side lies in a reached cell, a corner when
+/// the point 1.5 cells along its free direction does. So the outer faces of a
+/// closed building, which no robot inside can see, are left out. Ids are
+/// renumbered in order. Throws std::invalid_argument when p_W_start is inside
+/// a wall or cell_m <= 0.
+Map ReachableFeatures(const Map& truth, const std::vector<WallRectangle>& walls,
+                      const Eigen::Vector2d& p_W_start, double cell_m = 0.05);
+
 }  // namespace mjslam::eval

@@ -28,6 +28,9 @@ struct MapFeature {
   Eigen::Vector2d p_WA = Eigen::Vector2d::Zero();
   Eigen::Vector2d p_WB = Eigen::Vector2d::Zero();
   CornerKind corner_kind = CornerKind::kUnknown;
+  /// True corners: unit vector from the vertex into the free space (the
+  /// bisector of the two faces' outward normals); zero otherwise.
+  Eigen::Vector2d free_direction_W = Eigen::Vector2d::Zero();
 };
 
 using Map = std::vector<MapFeature>;

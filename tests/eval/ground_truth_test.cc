@@ -224,6 +224,30 @@ TEST(GroundTruthTest, RotatedRoomMatchesAxisAlignedRoomRotated) {
   ExpectLinesConsistent(b);
 }
 
+TEST(GroundTruthTest, ReachableFeaturesAreTheInsideOfTheRoom) {
+  const std::vector<WallRectangle> walls = {
+      Box(-4.15, -3.15, 4.15, -3.0), Box(4.0, -3.15, 4.15, 3.15),
+      Box(-4.15, 3.0, 4.15, 3.15), Box(-4.15, -3.15, -4.0, 3.15),
+      Box(0.0, -1.0, 1.0, -0.8)};  // a box standing in the room
+  const Map all = BuildGroundTruthMap(walls);
+  ASSERT_EQ(Count(all, MapFeature::Type::kLine), 12);
+  // From inside: the room's 4 inner faces and concave corners, the box's 4
+  // faces and convex corners; not the 4 outer faces and corners.
+  const Map inside = ReachableFeatures(all, walls, {-2.8, -1.8});
+  EXPECT_EQ(Count(inside, MapFeature::Type::kLine), 8);
+  EXPECT_EQ(CountCorners(inside, MapFeature::CornerKind::kConcave), 4);
+  EXPECT_EQ(CountCorners(inside, MapFeature::CornerKind::kConvex), 4);
+  EXPECT_EQ(CornerNear(inside, {4.15, 3.15}), nullptr);
+  EXPECT_NE(CornerNear(inside, {1.0, -0.8}), nullptr);
+  for (std::size_t i = 0; i < inside.size(); ++i) EXPECT_EQ(inside[i].id, static_cast<int>(i));
+  // From outside: the outer faces and corners only.
+  const Map outside = ReachableFeatures(all, walls, {10.0, 0.0});
+  EXPECT_EQ(Count(outside, MapFeature::Type::kLine), 4);
+  EXPECT_EQ(CountCorners(outside, MapFeature::CornerKind::kConvex), 4);
+  EXPECT_EQ(CountCorners(outside, MapFeature::CornerKind::kConcave), 0);
+  EXPECT_THROW(ReachableFeatures(all, walls, {0.5, -0.9}), std::invalid_argument);
+}
+
 TEST(GroundTruthTest, WallInsideAnotherAddsNothing) {
   const Map map = BuildGroundTruthMap({Box(0.0, 0.0, 4.0, 1.0), Box(1.0, 0.2, 2.0, 0.8)});
   EXPECT_EQ(Count(map, MapFeature::Type::kLine), 4);
