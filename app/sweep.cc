@@ -139,7 +139,7 @@ SweepResult RunSweep(const RunConfig& config, const SweepOptions& options) {
     bool evaluated = false;
     if (Completed(run_dir, &evaluated)) {
       ++result.runs_kept;
-      if (!evaluated) pending.push_back({i, run_dir, 1});
+      if (!evaluated && options.evaluate_runs) pending.push_back({i, run_dir, 1});
       continue;
     }
     fs::remove_all(run_dir);
@@ -191,10 +191,12 @@ SweepResult RunSweep(const RunConfig& config, const SweepOptions& options) {
         ++result.runs_failed;
         failures.push_back(job.dir + (job.stage == 0 ? ": run" : ": evaluate") +
                            " failed, see " + job.dir + ".log");
-      } else if (job.stage == 0) {
+      } else if (job.stage == 0 && options.evaluate_runs) {
         job.stage = 1;
         start(&job);
         active.push_back(job);
+        ++result.runs_made;
+      } else if (job.stage == 0) {
         ++result.runs_made;
       } else if (options.verbose) {
         std::fprintf(stderr, "%s: done\n", job.dir.c_str());

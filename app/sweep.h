@@ -23,6 +23,9 @@ struct SweepOptions {
   std::string out_dir;
   /// The mjslam program that runs (`run`) and evaluates (`evaluate`) each run.
   std::string program;
+  /// Evaluate each run (`mjslam evaluate`); without it the aggregate has the
+  /// NEES and times but no per-run metrics (runs_mean).
+  bool evaluate_runs = true;
   /// Divergence of each run's evaluation (`evaluate --divergence-points`);
   /// 0: none.
   int divergence_points = 0;
