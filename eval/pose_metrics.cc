@@ -4,10 +4,17 @@
 #include <limits>
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 
 #include "common/angles.h"
 
 namespace mjslam::eval {
+namespace {
+
+// Smallest eigenvalue of a covariance with a NEES, relative to the largest.
+constexpr double kMinEigenvalueRatio = 1e-12;
+
+}  // namespace
 
 PoseStepMetrics EvaluatePoseStep(const Pose2& X_W_true, const Pose2& X_W_estimate,
                                  const Eigen::Matrix3d& P_pose) {
@@ -18,8 +25,12 @@ PoseStepMetrics EvaluatePoseStep(const Pose2& X_W_true, const Pose2& X_W_estimat
     const double sigma = std::sqrt(std::max(P_pose(k, k), 0.0));
     m.inside_2sigma[k] = std::abs(m.error(k)) <= 2.0 * sigma + 1e-12;
   }
+  // Rank-deficient covariances (the first prediction from the known start adds
+  // a rank-2 input noise to P = 0) have no NEES: their inverse is rounding.
+  const Eigen::Vector3d eigenvalues =
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(P_pose, Eigen::EigenvaluesOnly).eigenvalues();
   const Eigen::LLT<Eigen::Matrix3d> llt(P_pose);
-  if (llt.info() == Eigen::Success && P_pose.diagonal().minCoeff() > 0.0) {
+  if (llt.info() == Eigen::Success && eigenvalues(0) > kMinEigenvalueRatio * eigenvalues(2)) {
     const Eigen::Vector3d whitened = llt.matrixL().solve(m.error);
     m.nees = whitened.squaredNorm();
   } else {

@@ -15,7 +15,9 @@ struct PoseStepMetrics {
   /// (-pi, pi]).
   Eigen::Vector3d error = Eigen::Vector3d::Zero();
   /// Pose NEES error^T P^-1 error (3 dof); NaN when P is not positive
-  /// definite (e.g. the known start pose, P = 0).
+  /// definite or nearly singular (smallest eigenvalue <= 1e-12 times the
+  /// largest): the known start pose (P = 0) and the first steps after it,
+  /// where P has the rank of the input noise.
   double nees = 0.0;
   /// |error_k| <= 2 sqrt(P_kk) per component (a zero error with zero
   /// variance counts as inside).

@@ -67,6 +67,13 @@ TEST(PoseMetricsTest, ZeroCovarianceHasNoNeesButCountsAZeroErrorInside) {
   const PoseStepMetrics m = EvaluatePoseStep(Pose2(1, 2, 3), Pose2(1, 2, 3), Eigen::Matrix3d::Zero());
   EXPECT_TRUE(std::isnan(m.nees));
   EXPECT_TRUE(m.inside_2sigma[0] && m.inside_2sigma[1] && m.inside_2sigma[2]);
+  // Rank 2 up to rounding (seen after the first prediction from P = 0): no
+  // NEES, where a plain inverse would give ~1e11.
+  Eigen::Matrix3d J;
+  J << 1.0, 0.2, 0.0, 0.3, 1.0, 0.0, 0.1, 0.4, 0.0;
+  const Eigen::Matrix3d rank2 = 1e-6 * J * J.transpose() + 1e-24 * Eigen::Matrix3d::Identity();
+  const PoseStepMetrics r = EvaluatePoseStep(Pose2(1, 2, 0), Pose2(1.001, 2, 0.001), rank2);
+  EXPECT_TRUE(std::isnan(r.nees)) << r.nees;
 }
 
 TEST(PoseMetricsTest, SummaryOfGaussianErrorsIsConsistent) {
