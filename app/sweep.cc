@@ -354,6 +354,13 @@ nlohmann::json AggregateSweep(const std::vector<std::string>& run_dirs, const st
     }
     summary["filters"][names[f]] = j;
   }
+  // The mean of the runs' divergences, when they were evaluated with one.
+  for (const char* pair : {"classical_selective", "selective_classical", "classical_truth",
+                           "selective_truth"}) {
+    const nlohmann::json value =
+        MeanOf(summaries, nlohmann::json::json_pointer(std::string("/divergence/") + pair));
+    if (!value.is_null()) summary["divergence"]["runs_mean"][pair] = value;
+  }
   return summary;
 }
 
