@@ -3,7 +3,6 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <limits>
 #include <stdexcept>
 
 #include "app/csv_writer.h"
@@ -16,7 +15,6 @@
 namespace mjslam::app {
 namespace {
 
-constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 nlohmann::json Xyz(const Eigen::Vector3d& v) {
   return {{"x", v(0)}, {"y", v(1)}, {"th", v(2)}};
