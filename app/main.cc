@@ -96,7 +96,9 @@ int main(int argc, char** argv) {
   std::vector<int> study_points;
   sweep->add_option("--config", config_path, "YAML config file")->capture_default_str();
   sweep->add_option("--runs", sweep_options.runs, "Number of runs")->required()->check(CLI::PositiveNumber);
-  sweep->add_option("--jobs", sweep_options.jobs, "Runs at a time")->capture_default_str()->check(CLI::PositiveNumber);
+  sweep->add_option("--jobs", sweep_options.jobs, "Runs at a time (0: one per core)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
   sweep->add_option("--out", out_dir, "Sweep directory")->required();
   sweep->add_option("--set", overrides, "Override any config key")->type_name("KEY=VALUE");
   sweep->add_option("--duration", duration_s, "Simulated seconds of each run (overrides run.duration_s)");

@@ -104,7 +104,9 @@ nlohmann::json MeanOf(const std::vector<nlohmann::json>& summaries, const nlohma
 SweepResult RunSweep(const RunConfig& config, const SweepOptions& options) {
   config.ValidateOrThrow();
   if (options.runs < 1) throw std::runtime_error("sweep: --runs must be >= 1 (got " + std::to_string(options.runs) + ")");
-  if (options.jobs < 1) throw std::runtime_error("sweep: --jobs must be >= 1 (got " + std::to_string(options.jobs) + ")");
+  if (options.jobs < 0) throw std::runtime_error("sweep: --jobs must be >= 0 (got " + std::to_string(options.jobs) + ")");
+  const int jobs = options.jobs > 0 ? options.jobs
+                                    : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
   if (options.out_dir.empty()) throw std::runtime_error("sweep: --out is required");
   if (!fs::is_regular_file(options.program)) {
     throw std::runtime_error("sweep: program not found: '" + options.program + "'");
@@ -170,7 +172,7 @@ SweepResult RunSweep(const RunConfig& config, const SweepOptions& options) {
       result.interrupted = true;
       return result;
     }
-    while (static_cast<int>(active.size()) < options.jobs && !pending.empty()) {
+    while (static_cast<int>(active.size()) < jobs && !pending.empty()) {
       Job job = pending.front();
       pending.pop_front();
       start(&job);
@@ -214,7 +216,7 @@ SweepResult RunSweep(const RunConfig& config, const SweepOptions& options) {
   result.summary["sweep"]["runs_made"] = result.runs_made;
   result.summary["sweep"]["runs_kept"] = result.runs_kept;
   result.summary["sweep"]["base_seed"] = config.run.seed;
-  result.summary["sweep"]["jobs"] = options.jobs;
+  result.summary["sweep"]["jobs"] = jobs;
   WriteJsonAtomically(dir + "/summary.json", result.summary);
   if (!options.divergence_study_points.empty()) {
     WriteDivergenceStudy(run_dirs.front(), options.divergence_study_points,

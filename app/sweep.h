@@ -17,8 +17,9 @@ struct SweepOptions {
   /// Number of runs; run i has seed run.seed + i and lives in
   /// out_dir/runs/run_<i, 3 digits>.
   int runs = 1;
-  /// Runs at a time (separate processes).
-  int jobs = 1;
+  /// Runs at a time (separate processes); 0: one per core
+  /// (std::thread::hardware_concurrency()).
+  int jobs = 0;
   /// The sweep directory.
   std::string out_dir;
   /// The mjslam program that runs (`run`) and evaluates (`evaluate`) each run.
