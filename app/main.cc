@@ -9,10 +9,12 @@
 
 #include <CLI/CLI.hpp>
 
+#include "app/evaluate.h"
 #include "app/replay.h"
 #include "app/run.h"
 #include "app/run_config.h"
 #include "app/run_files.h"
+#include "app/sweep.h"
 #include "config/config.h"
 
 namespace {
@@ -73,6 +75,58 @@ int main(int argc, char** argv) {
   show_config->add_option("--config", config_path, "YAML config file")->capture_default_str();
   show_config->add_option("--set", overrides, "Override any config key")->type_name("KEY=VALUE");
 
+  // mjslam evaluate
+  CLI::App* evaluate = cli.add_subcommand(
+      "evaluate", "Ground truth, pose and map metrics of a run directory, into summary.json");
+  std::string run_dir;
+  mjslam::app::EvaluateOptions evaluate_options;
+  evaluate->add_option("RUN_DIR", run_dir, "Run directory")->required();
+  evaluate->add_option("--divergence-points", evaluate_options.divergence_points,
+                       "Monte Carlo points of the map divergence (0: none)")
+      ->capture_default_str();
+  evaluate->add_option("--realisations", evaluate_options.divergence_realisations,
+                       "Realisations of the divergence (their mean is reported)")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+
+  // mjslam sweep
+  CLI::App* sweep = cli.add_subcommand(
+      "sweep", "Monte Carlo runs with seeds run.seed + i, evaluated and aggregated");
+  mjslam::app::SweepOptions sweep_options;
+  std::vector<int> study_points;
+  sweep->add_option("--config", config_path, "YAML config file")->capture_default_str();
+  sweep->add_option("--runs", sweep_options.runs, "Number of runs")->required()->check(CLI::PositiveNumber);
+  sweep->add_option("--jobs", sweep_options.jobs, "Runs at a time (0: one per core)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  sweep->add_option("--out", out_dir, "Sweep directory")->required();
+  sweep->add_option("--set", overrides, "Override any config key")->type_name("KEY=VALUE");
+  sweep->add_option("--duration", duration_s, "Simulated seconds of each run (overrides run.duration_s)");
+  sweep->add_option("--divergence-points", sweep_options.divergence_points,
+                    "Map divergence points of each run's evaluation (0: none)")
+      ->capture_default_str();
+  sweep->add_option("--divergence-study", study_points,
+                    "Also write DIR/divergence.csv from the first run for these #E (e.g. 100 1000 20000)");
+  sweep->add_option("--study-realisations", sweep_options.divergence_study_realisations,
+                    "Realisations per #E of --divergence-study")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  sweep->add_flag("--quiet", quiet, "No line per finished run");
+
+  // mjslam divergence
+  CLI::App* divergence = cli.add_subcommand(
+      "divergence", "The paper's map divergence study (Figs. 6, 7) of a run directory");
+  std::vector<int> num_points = {100, 200, 500, 1000, 2000, 5000, 10000, 20000};
+  int realisations = 100;
+  std::string divergence_out;
+  divergence->add_option("RUN_DIR", run_dir, "Run directory")->required();
+  divergence->add_option("--points", num_points, "Numbers of Monte Carlo points #E")
+      ->capture_default_str();
+  divergence->add_option("--realisations", realisations, "Realisations per #E")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  divergence->add_option("--out", divergence_out, "Output CSV [RUN_DIR/divergence.csv]");
+
   CLI11_PARSE(cli, argc, argv);
 
   std::signal(SIGINT, RequestStop);
@@ -116,6 +170,62 @@ int main(int argc, char** argv) {
       options.command_line = JoinArguments(argc, argv);
       mjslam::app::Replay(config, options);
       std::fprintf(stderr, "%s: replay completed\n", out_dir.c_str());
+      return 0;
+    }
+    if (evaluate->parsed()) {
+      const mjslam::app::RunEvaluation result =
+          mjslam::app::EvaluateRunDirectory(run_dir, evaluate_options);
+      std::printf("%-10s %8s %8s %8s %9s %8s %9s %6s %6s\n", "filter", "in2s_x", "in2s_y",
+                  "in2s_th", "mean_nees", "matched", "dupl", "unm", "incons");
+      for (std::size_t i = 0; i < result.pose.size(); ++i) {
+        const auto& p = result.pose[i];
+        const auto& m = result.map[i];
+        std::printf("%-10s %8.3f %8.3f %8.3f %9.3f %8.3f %9d %6d %6d\n",
+                    mjslam::app::FilterNames()[i].c_str(), p.inside_2sigma(0),
+                    p.inside_2sigma(1), p.inside_2sigma(2), p.mean_nees, m.matched_fraction,
+                    m.num_duplicates, m.num_unmatched_estimates, m.num_inconsistent);
+      }
+      if (result.has_divergence) {
+        std::printf("divergence: classical||selective %.4g, selective||classical %.4g, "
+                    "classical||truth %.4g, selective||truth %.4g\n",
+                    result.divergence.classical_selective, result.divergence.selective_classical,
+                    result.divergence.classical_truth, result.divergence.selective_truth);
+      }
+      return 0;
+    }
+    if (sweep->parsed()) {
+      if (sweep->count("--duration") > 0) {
+        overrides.push_back("run.duration_s=" + mjslam::ValueText(duration_s));
+      }
+      const RunConfig config = mjslam::app::LoadRunConfig(config_path, overrides);
+      sweep_options.out_dir = out_dir;
+      sweep_options.program = std::filesystem::read_symlink("/proc/self/exe").string();
+      sweep_options.divergence_study_points = study_points;
+      sweep_options.verbose = !quiet;
+      sweep_options.stop_requested = &g_stop_requested;
+      const mjslam::app::SweepResult result = mjslam::app::RunSweep(config, sweep_options);
+      if (result.interrupted) {
+        std::fprintf(stderr, "%s: interrupted; run the same command again to resume\n",
+                     out_dir.c_str());
+        return 130;
+      }
+      for (const std::string& name : mjslam::app::FilterNames()) {
+        const auto& f = result.summary["filters"][name];
+        std::printf("%-10s ANEES inside the bounds for %.3f of the steps (above %.3f, below "
+                    "%.3f), mean ANEES %.3f: %s\n",
+                    name.c_str(), f["fraction_inside"].get<double>(),
+                    f["fraction_above"].get<double>(), f["fraction_below"].get<double>(),
+                    f["mean_anees"].is_number() ? f["mean_anees"].get<double>() : 0.0,
+                    f["verdict"].get<std::string>().c_str());
+      }
+      std::fprintf(stderr, "%s: %d runs made, %d kept\n", out_dir.c_str(), result.runs_made,
+                   result.runs_kept);
+      return 0;
+    }
+    if (divergence->parsed()) {
+      const std::string out = divergence_out.empty() ? run_dir + "/divergence.csv" : divergence_out;
+      mjslam::app::WriteDivergenceStudy(run_dir, num_points, realisations, out);
+      std::fprintf(stderr, "%s: written\n", out.c_str());
       return 0;
     }
   } catch (const std::exception& error) {

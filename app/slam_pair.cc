@@ -1,13 +1,11 @@
 #include "app/slam_pair.h"
 
 #include <chrono>
-#include <limits>
+#include <cmath>
 #include <string>
 
-#include <Eigen/Cholesky>
-
 #include "app/run_files.h"
-#include "common/angles.h"
+#include "eval/pose_metrics.h"
 #include "slam/feature_extraction.h"
 
 namespace mjslam::app {
@@ -76,7 +74,13 @@ void SlamPair::AddColumns(const Pose2& X_WR_true, CsvWriter* writer) const {
     writer->Add(f.report.num_updated);
     writer->Add(f.processing_us);
     writer->Add(f.period_steps * dt_s_);
-    writer->Add(PoseNees(X_WR, P, X_WR_true));
+    // Empty where P is (nearly) singular: the known start and the steps after.
+    const double nees = eval::EvaluatePoseStep(X_WR_true, X_WR, P).nees;
+    if (std::isfinite(nees)) {
+      writer->Add(nees);
+    } else {
+      writer->AddEmpty();
+    }
   }
 }
 
@@ -84,17 +88,6 @@ void SlamPair::WriteMaps(const std::string& dir) const {
   for (const Filter& f : filters_) {
     WriteMapCsv(dir + "/map_" + f.name + ".csv", f.filter.Map());
   }
-}
-
-double PoseNees(const Pose2& estimate, const Eigen::Matrix3d& P, const Pose2& truth) {
-  const Eigen::Vector3d e(estimate.x - truth.x, estimate.y - truth.y,
-                          WrapAngle(estimate.theta - truth.theta));
-  if (e.isZero(0.0)) return 0.0;
-  const Eigen::LDLT<Eigen::Matrix3d> ldlt(P);
-  if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0.0)) {
-    return std::numeric_limits<double>::infinity();
-  }
-  return e.dot(ldlt.solve(e));
 }
 
 void WriteMapCsv(const std::string& path, const std::vector<slam::MapFeature>& map) {

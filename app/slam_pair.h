@@ -68,9 +68,4 @@ class SlamPair {
 /// atomically.
 void WriteMapCsv(const std::string& path, const std::vector<slam::MapFeature>& map);
 
-/// NEES of a pose estimate against the truth, e^T P^-1 e with the heading
-/// error wrapped; 0 when the error is zero (the known start, P = 0), and
-/// +infinity when P is singular along a nonzero error.
-double PoseNees(const Pose2& estimate, const Eigen::Matrix3d& P, const Pose2& truth);
-
 }  // namespace mjslam::app

@@ -53,9 +53,9 @@ struct FeatureExtractionParams {
   /// Model-error floor added to each line's (rho, alpha) variances, one
   /// standard deviation each: walls are not perfectly straight in real life.
   /// In the simulator they are exact planes, so the defaults are small.
-  double line_rho_floor_std_m = 0.0002;
+  double line_rho_floor_std_m = 0.0001;
   /// See `line_rho_floor_std_m`; degrees.
-  double line_alpha_floor_std_deg = 0.005;
+  double line_alpha_floor_std_deg = 0.0025;
 
   /// Two neighbouring lines of one cluster meet at a corner only when the
   /// acute angle between them is at least this, degrees (in (0, 90]).

@@ -1,0 +1,240 @@
+#include "app/evaluate.h"
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <stdexcept>
+
+#include "app/csv_writer.h"
+#include "app/run_config.h"
+#include "app/run_files.h"
+#include "common/rng.h"
+#include "sim/obstacles.h"
+#include "sim/simulator.h"
+
+namespace mjslam::app {
+namespace {
+
+
+nlohmann::json Xyz(const Eigen::Vector3d& v) {
+  return {{"x", v(0)}, {"y", v(1)}, {"th", v(2)}};
+}
+
+// NaN as JSON null (nlohmann writes NaN as null anyway; explicit for clarity).
+nlohmann::json Number(double value) {
+  return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(nullptr);
+}
+
+}  // namespace
+
+nlohmann::json ReadJsonFile(const std::string& path, const nlohmann::json& fallback) {
+  if (!std::filesystem::exists(path)) return fallback;
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(path + ": cannot be read");
+  try {
+    return nlohmann::json::parse(in);
+  } catch (const nlohmann::json::exception& error) {
+    throw std::runtime_error(path + ": not valid JSON: " + error.what());
+  }
+}
+
+eval::Map RunGroundTruth(const std::string& run_dir, const eval::GroundTruthParams& params) {
+  const std::string config_path = run_dir + "/config.yaml";
+  if (!std::filesystem::is_regular_file(config_path)) {
+    throw std::runtime_error(config_path + ": missing (is '" + run_dir + "' a run directory?)");
+  }
+  const RunConfig config = LoadRunConfig(config_path, {});
+  const sim::Simulator simulator(config.run.world, config.run.robot_model, config.sim,
+                                 config.robot);
+  std::vector<eval::WallRectangle> walls;
+  for (const sim::ObstacleFootprint& obstacle : simulator.Obstacles()) {
+    if (obstacle.shape != sim::ObstacleFootprint::Shape::kRectangle) continue;
+    const std::array<Eigen::Vector2d, 4> corners = sim::RectangleCorners(obstacle);
+    walls.push_back({corners});
+  }
+  try {
+    // Only what faces the free space the robot starts in.
+    return eval::ReachableFeatures(eval::BuildGroundTruthMap(walls, params), walls,
+                                   simulator.X_WR().translation());
+  } catch (const std::invalid_argument& error) {
+    throw std::runtime_error(config.run.world + ": " + error.what());
+  }
+}
+
+eval::Map ReadMapCsv(const std::string& path) {
+  const CsvTable table = ReadCsv(path, {"type"});
+  const int id = table.ColumnIndex("id");
+  table.ColumnIndex("type");  // throws when missing
+  const int p0 = table.ColumnIndex("p0");
+  const int c00 = table.ColumnIndex("c00");
+  const int ax = table.ColumnIndex("ax");
+  eval::Map map;
+  for (std::size_t r = 0; r < table.rows.size(); ++r) {
+    const std::vector<double>& row = table.rows[r];
+    const std::string& kind = table.text[r][0];  // the only text column
+    const std::string where = path + ":" + std::to_string(r + 2) + ": ";
+    eval::MapFeature f;
+    f.id = static_cast<int>(row[id]);
+    if (kind == "line") {
+      f.type = eval::MapFeature::Type::kLine;
+    } else if (kind == "corner") {
+      f.type = eval::MapFeature::Type::kCorner;
+    } else {
+      throw std::runtime_error(where + "type: expected line or corner (got '" + kind + "')");
+    }
+    f.params = {row[p0], row[p0 + 1]};
+    f.covariance << row[c00], row[c00 + 1], row[c00 + 1], row[c00 + 2];
+    if (!f.params.allFinite() || !f.covariance.allFinite()) {
+      throw std::runtime_error(where + "p0, p1, c00, c01, c11: expected numbers");
+    }
+    f.has_segment = f.type == eval::MapFeature::Type::kLine && std::isfinite(row[ax]) &&
+                    std::isfinite(row[ax + 1]) && std::isfinite(row[ax + 2]) &&
+                    std::isfinite(row[ax + 3]);
+    if (f.has_segment) {
+      f.p_WA = {row[ax], row[ax + 1]};
+      f.p_WB = {row[ax + 2], row[ax + 3]};
+    }
+    map.push_back(f);
+  }
+  return map;
+}
+
+void WriteEvalMapCsv(const std::string& path, const eval::Map& map) {
+  std::string text = "id,type,p0,p1,c00,c01,c11,ax,ay,bx,by\n";
+  for (const eval::MapFeature& f : map) {
+    const bool line = f.type == eval::MapFeature::Type::kLine;
+    text += std::to_string(f.id) + (line ? ",line," : ",corner,");
+    for (const double v : {f.params.x(), f.params.y(), f.covariance(0, 0), f.covariance(0, 1),
+                           f.covariance(1, 1)}) {
+      text += FormatDouble(v) + ",";
+    }
+    if (line && f.has_segment) {
+      text += FormatDouble(f.p_WA.x()) + "," + FormatDouble(f.p_WA.y()) + "," +
+              FormatDouble(f.p_WB.x()) + "," + FormatDouble(f.p_WB.y());
+    } else {
+      text += ",,,";
+    }
+    text += "\n";
+  }
+  WriteFileAtomically(path, text);
+}
+
+std::vector<eval::PoseStepMetrics> PoseSteps(const CsvTable& trajectory, const std::string& name) {
+  const int truth = trajectory.ColumnIndex("true_x");
+  const int estimate = trajectory.ColumnIndex(name + "_x");
+  const int pxx = trajectory.ColumnIndex(name + "_pxx");
+  std::vector<eval::PoseStepMetrics> steps;
+  for (const std::vector<double>& row : trajectory.rows) {
+    Eigen::Matrix3d P;
+    P << row[pxx], row[pxx + 1], row[pxx + 2], row[pxx + 1], row[pxx + 3], row[pxx + 4],
+        row[pxx + 2], row[pxx + 4], row[pxx + 5];
+    steps.push_back(eval::EvaluatePoseStep(Pose2(row[truth], row[truth + 1], row[truth + 2]),
+                                           Pose2(row[estimate], row[estimate + 1],
+                                                 row[estimate + 2]),
+                                           P));
+  }
+  return steps;
+}
+
+std::vector<double> PoseNees(const CsvTable& trajectory, const std::string& name) {
+  std::vector<double> nees;
+  for (std::size_t c = 0; c < trajectory.columns.size(); ++c) {
+    if (trajectory.columns[c] != name + "_nees") continue;
+    for (const std::vector<double>& row : trajectory.rows) nees.push_back(row[c]);
+    return nees;
+  }
+  for (const eval::PoseStepMetrics& m : PoseSteps(trajectory, name)) nees.push_back(m.nees);
+  return nees;
+}
+
+RunEvaluation EvaluateRunDirectory(const std::string& run_dir, const EvaluateOptions& options) {
+  options.ground_truth.ValidateOrThrow();
+  options.match.ValidateOrThrow();
+  options.divergence.ValidateOrThrow();
+  const nlohmann::json manifest = ReadJsonFile(run_dir + "/manifest.json", nullptr);
+  if (manifest.is_null()) throw std::runtime_error(run_dir + "/manifest.json: missing");
+  RunEvaluation result;
+  result.truth = RunGroundTruth(run_dir, options.ground_truth);
+  WriteEvalMapCsv(run_dir + "/ground_truth_map.csv", result.truth);
+
+  // Poses and maps of both filters.
+  const CsvTable trajectory = ReadCsv(run_dir + "/trajectory.csv");
+  if (trajectory.rows.empty()) throw std::runtime_error(run_dir + "/trajectory.csv: no rows");
+  std::vector<eval::Map> maps;
+  for (const std::string& name : FilterNames()) {
+    std::vector<eval::PoseStepMetrics> steps = PoseSteps(trajectory, name);
+    const std::vector<double> nees = PoseNees(trajectory, name);
+    for (std::size_t k = 0; k < steps.size(); ++k) steps[k].nees = nees[k];
+    result.pose.push_back(eval::SummarisePoseSteps(steps));
+    maps.push_back(ReadMapCsv(run_dir + "/map_" + name + ".csv"));
+    result.map.push_back(eval::MatchMaps(maps.back(), result.truth, options.match));
+  }
+  if (options.divergence_points > 0) {
+    const std::uint64_t seed = manifest.value("seed", std::uint64_t{0});
+    const std::vector<eval::DivergenceStatistics> rows = eval::DivergenceStudy(
+        maps[0], maps[1], result.truth, {options.divergence_points},
+        options.divergence_realisations, Rng(seed).Fork("evaluate"), options.divergence);
+    result.has_divergence = true;
+    result.divergence = {rows[0].mean, rows[1].mean, rows[2].mean, rows[3].mean};
+  }
+
+  // Merge into summary.json.
+  const std::string summary_path = run_dir + "/summary.json";
+  nlohmann::json summary = ReadJsonFile(summary_path, nlohmann::json::object());
+  if (!summary.is_object()) throw std::runtime_error(summary_path + ": expected a JSON object");
+  for (std::size_t i = 0; i < FilterNames().size(); ++i) {
+    nlohmann::json& f = summary["filters"][FilterNames()[i]];
+    const eval::PoseSummary& pose = result.pose[i];
+    const eval::MapMatchReport& map = result.map[i];
+    f["inside_2sigma"] = Xyz(pose.inside_2sigma);
+    f["rmse"] = Xyz(pose.rmse);
+    f["mean_nees"] = Number(pose.mean_nees);
+    f["final_pose_error"] = Xyz(pose.final_error);
+    f["num_features"] = static_cast<int>(maps[i].size());
+    f["map"] = {{"num_estimates", map.num_estimates},
+                {"num_truth", map.num_truth},
+                {"matched_estimates", map.num_matched_estimates},
+                {"matched_truth", map.num_matched_truth},
+                {"matched_fraction", map.matched_fraction},
+                {"duplicates", map.num_duplicates},
+                {"unmatched_estimates", map.num_unmatched_estimates},
+                {"inconsistent", map.num_inconsistent},
+                {"mean_feature_nees", Number(map.mean_nees)},
+                {"line_rho_rmse_m", Number(map.line_rho_rmse_m)},
+                {"line_alpha_rmse_rad", Number(map.line_alpha_rmse_rad)},
+                {"corner_rmse_m", Number(map.corner_rmse_m)}};
+  }
+  if (result.has_divergence) {
+    summary["divergence"] = {{"num_points", options.divergence_points},
+                             {"realisations", options.divergence_realisations},
+                             {"classical_selective", result.divergence.classical_selective},
+                             {"selective_classical", result.divergence.selective_classical},
+                             {"classical_truth", result.divergence.classical_truth},
+                             {"selective_truth", result.divergence.selective_truth}};
+  }
+  WriteJsonAtomically(summary_path, summary);
+  return result;
+}
+
+std::vector<eval::DivergenceStatistics> WriteDivergenceStudy(
+    const std::string& run_dir, const std::vector<int>& num_points, int realisations,
+    const std::string& out_path, const EvaluateOptions& options) {
+  const nlohmann::json manifest = ReadJsonFile(run_dir + "/manifest.json", nullptr);
+  if (manifest.is_null()) throw std::runtime_error(run_dir + "/manifest.json: missing");
+  const eval::Map truth = RunGroundTruth(run_dir, options.ground_truth);
+  const eval::Map classical = ReadMapCsv(run_dir + "/map_classical.csv");
+  const eval::Map selective = ReadMapCsv(run_dir + "/map_selective.csv");
+  const std::uint64_t seed = manifest.value("seed", std::uint64_t{0});
+  const std::vector<eval::DivergenceStatistics> rows =
+      eval::DivergenceStudy(classical, selective, truth, num_points, realisations,
+                            Rng(seed).Fork("divergence"), options.divergence);
+  std::string text = "num_points,pair,mean,variance\n";
+  for (const eval::DivergenceStatistics& row : rows) {
+    text += std::to_string(row.num_points) + "," + row.pair + "," + FormatDouble(row.mean) + "," +
+            FormatDouble(row.variance) + "\n";
+  }
+  WriteFileAtomically(out_path, text);
+  return rows;
+}
+
+}  // namespace mjslam::app

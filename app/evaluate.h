@@ -1,0 +1,93 @@
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "app/csv_reader.h"
+#include "eval/ground_truth.h"
+#include "eval/map_divergence.h"
+#include "eval/map_matching.h"
+#include "eval/map_types.h"
+#include "eval/pose_metrics.h"
+
+namespace mjslam::app {
+
+/// How `mjslam evaluate` evaluates a run directory.
+struct EvaluateOptions {
+  eval::GroundTruthParams ground_truth;
+  eval::MatchParams match;
+  eval::DivergenceParams divergence;
+  /// Monte Carlo points of the map divergence (0: no divergence).
+  int divergence_points = 20000;
+  /// Realisations of the divergence (their mean is reported).
+  int divergence_realisations = 1;
+};
+
+/// The names of the two filters, as in file and column names.
+inline const std::vector<std::string>& FilterNames() {
+  static const std::vector<std::string> kNames = {"classical", "selective"};
+  return kNames;
+}
+
+/// What EvaluateRunDirectory found, per filter in the order of FilterNames().
+struct RunEvaluation {
+  eval::Map truth;
+  std::vector<eval::PoseSummary> pose;
+  std::vector<eval::MapMatchReport> map;
+  /// Set when divergence_points > 0.
+  bool has_divergence = false;
+  eval::MapDivergences divergence;
+};
+
+/// The true map of the run's world: the wall (box) footprints of
+/// sim::Simulator::Obstacles() of the world in the run's config.yaml, through
+/// eval::BuildGroundTruthMap, restricted to the features that face the free
+/// space reachable from the robot's start (eval::ReachableFeatures); pillars
+/// (round or other non-box geoms) are left out. Throws naming the file when the run directory's config or world
+/// cannot be loaded.
+eval::Map RunGroundTruth(const std::string& run_dir, const eval::GroundTruthParams& params = {});
+
+/// Reads a map CSV (map_classical.csv, map_selective.csv,
+/// ground_truth_map.csv). Throws std::runtime_error naming the file, line and
+/// value for an unknown type or a missing field.
+eval::Map ReadMapCsv(const std::string& path);
+
+/// Writes a map as CSV in the columns of the filters' maps
+/// (id,type,p0,p1,c00,c01,c11,ax,ay,bx,by), atomically. Corner kinds are not
+/// written (the columns have no place for them).
+void WriteEvalMapCsv(const std::string& path, const eval::Map& map);
+
+/// The pose NEES (3 dof) of filter `name` at every row of a trajectory.csv
+/// table: its `<name>_nees` column when present, else computed from the
+/// estimate, the truth and the covariance columns (NaN where the covariance
+/// is not positive definite, e.g. the known start).
+std::vector<double> PoseNees(const CsvTable& trajectory, const std::string& name);
+
+/// Evaluates a finished run directory: builds the ground truth
+/// (RunGroundTruth) and writes it to ground_truth_map.csv, compares both
+/// filters' poses (trajectory.csv) and maps (map_<filter>.csv) with the
+/// truth and, when asked, computes the map divergence (seeded from the run's
+/// seed). Merges the results into summary.json (created if missing; other
+/// writers' keys are kept): for each filter `filters.<f>.inside_2sigma`,
+/// `rmse` ({x, y, th}), `mean_nees`, `final_pose_error` ({x, y, th}),
+/// `num_features`, `map` {...}, and `divergence` {...} (README, "mjslam
+/// evaluate"). Files are written atomically. Throws std::runtime_error naming
+/// the file for a missing or malformed input.
+RunEvaluation EvaluateRunDirectory(const std::string& run_dir, const EvaluateOptions& options = {});
+
+/// Reads a JSON file (std::runtime_error naming it when unreadable or not
+/// JSON); a missing file gives `fallback`.
+nlohmann::json ReadJsonFile(const std::string& path, const nlohmann::json& fallback);
+
+/// `mjslam divergence`: the paper's Figs. 6 and 7 for one run directory.
+/// For each entry of `num_points`, `realisations` realisations of the four
+/// divergences (eval::DivergenceStudy, seeded from the run's seed), written
+/// to `out_path` as divergence.csv (num_points,pair,mean,variance),
+/// atomically. Returns the rows.
+std::vector<eval::DivergenceStatistics> WriteDivergenceStudy(
+    const std::string& run_dir, const std::vector<int>& num_points, int realisations,
+    const std::string& out_path, const EvaluateOptions& options = {});
+
+}  // namespace mjslam::app

@@ -1,0 +1,369 @@
+#include "app/sweep.h"
+
+#include <signal.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <deque>
+#include <fcntl.h>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <stdexcept>
+#include <thread>
+
+#include "app/csv_reader.h"
+#include "app/csv_writer.h"
+#include "app/run_files.h"
+#include "config/config.h"
+#include "eval/chi_square.h"
+
+extern char** environ;
+
+namespace mjslam::app {
+namespace {
+
+namespace fs = std::filesystem;
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+std::string RunName(int index) {
+  char name[32];
+  std::snprintf(name, sizeof(name), "run_%03d", index);
+  return name;
+}
+
+std::string ReadText(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
+}
+
+// Starts `argv` with stdout and stderr appended to `log_path`.
+pid_t Spawn(const std::vector<std::string>& argv, const std::string& log_path) {
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log_path.c_str(),
+                                   O_WRONLY | O_CREAT | O_APPEND, 0644);
+  posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
+  std::vector<char*> args;
+  for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+  args.push_back(nullptr);
+  pid_t pid = -1;
+  const int error = posix_spawn(&pid, argv[0].c_str(), &actions, nullptr, args.data(), environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (error != 0) {
+    throw std::runtime_error("cannot start '" + argv[0] + "': " + std::strerror(error));
+  }
+  return pid;
+}
+
+// True when the run directory holds a completed run; `evaluated` tells if its
+// summary has the metrics of `mjslam evaluate`.
+bool Completed(const std::string& dir, bool* evaluated) {
+  nlohmann::json manifest;
+  nlohmann::json summary;
+  try {
+    manifest = ReadJsonFile(dir + "/manifest.json", nullptr);
+    summary = ReadJsonFile(dir + "/summary.json", nullptr);
+  } catch (const std::runtime_error&) {
+    return false;  // a file cut short: redo the run
+  }
+  if (!manifest.is_object() || manifest.value("status", "") != "completed") return false;
+  *evaluated = summary.is_object() && summary.contains("filters") &&
+               summary["filters"].contains("selective") &&
+               summary["filters"]["selective"].contains("mean_nees") &&
+               fs::exists(dir + "/ground_truth_map.csv");
+  return true;
+}
+
+// Mean over runs of the numbers at `pointer` in each run's summary (null if
+// none has one).
+nlohmann::json MeanOf(const std::vector<nlohmann::json>& summaries, const nlohmann::json::json_pointer& pointer) {
+  double sum = 0.0;
+  int count = 0;
+  for (const nlohmann::json& s : summaries) {
+    if (!s.contains(pointer)) continue;
+    const nlohmann::json& v = s.at(pointer);
+    if (!v.is_number()) continue;
+    sum += v.get<double>();
+    ++count;
+  }
+  return count > 0 ? nlohmann::json(sum / count) : nlohmann::json(nullptr);
+}
+
+}  // namespace
+
+SweepResult RunSweep(const RunConfig& config, const SweepOptions& options) {
+  config.ValidateOrThrow();
+  if (options.runs < 1) throw std::runtime_error("sweep: --runs must be >= 1 (got " + std::to_string(options.runs) + ")");
+  if (options.jobs < 0) throw std::runtime_error("sweep: --jobs must be >= 0 (got " + std::to_string(options.jobs) + ")");
+  const int jobs = options.jobs > 0 ? options.jobs
+                                    : std::max(1, static_cast<int>(std::thread::hardware_concurrency()));
+  if (options.out_dir.empty()) throw std::runtime_error("sweep: --out is required");
+  if (!fs::is_regular_file(options.program)) {
+    throw std::runtime_error("sweep: program not found: '" + options.program + "'");
+  }
+  const std::string dir = options.out_dir;
+  MakeRunDirectory(dir);
+  MakeRunDirectory(dir + "/runs");
+
+  // One config per sweep directory: a resumed sweep must be the same sweep.
+  const std::string config_path = dir + "/config.yaml";
+  const std::string config_text = config::ToYaml(config);
+  if (fs::exists(config_path) && ReadText(config_path) != config_text) {
+    throw std::runtime_error(config_path +
+                             ": this sweep directory was made with another config; use the same "
+                             "config and --set options to resume it, or another --out");
+  }
+  WriteFileAtomically(config_path, config_text);
+
+  // What each run needs: 0 run and evaluate, 1 evaluate only, 2 nothing.
+  struct Job {
+    int index;
+    std::string dir;
+    int stage;
+    pid_t pid = -1;
+  };
+  std::deque<Job> pending;
+  SweepResult result;
+  std::vector<std::string> run_dirs;
+  for (int i = 0; i < options.runs; ++i) {
+    const std::string run_dir = dir + "/runs/" + RunName(i);
+    run_dirs.push_back(run_dir);
+    bool evaluated = false;
+    if (Completed(run_dir, &evaluated)) {
+      ++result.runs_kept;
+      if (!evaluated && options.evaluate_runs) pending.push_back({i, run_dir, 1});
+      continue;
+    }
+    fs::remove_all(run_dir);
+    fs::remove(run_dir + ".log");
+    pending.push_back({i, run_dir, 0});
+  }
+
+  auto start = [&](Job* job) {
+    const std::uint64_t seed = config.run.seed + static_cast<std::uint64_t>(job->index);
+    if (job->stage == 0) {
+      job->pid = Spawn({options.program, "run", "--quiet", "--config", config_path, "--seed",
+                        std::to_string(seed), "--out", job->dir},
+                       job->dir + ".log");
+    } else {
+      job->pid = Spawn({options.program, "evaluate", job->dir, "--divergence-points",
+                        std::to_string(options.divergence_points)},
+                       job->dir + ".log");
+    }
+  };
+  std::vector<Job> active;
+  std::vector<std::string> failures;
+  while (!pending.empty() || !active.empty()) {
+    const bool stop = options.stop_requested != nullptr && *options.stop_requested != 0;
+    if (stop) {
+      // Stop the running ones; the next sweep redoes them.
+      for (const Job& job : active) ::kill(job.pid, SIGTERM);
+      for (const Job& job : active) ::waitpid(job.pid, nullptr, 0);
+      result.interrupted = true;
+      return result;
+    }
+    while (static_cast<int>(active.size()) < jobs && !pending.empty()) {
+      Job job = pending.front();
+      pending.pop_front();
+      start(&job);
+      active.push_back(job);
+    }
+    int status = 0;
+    const pid_t pid = ::waitpid(-1, &status, WNOHANG);
+    if (pid <= 0) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      continue;
+    }
+    for (std::size_t k = 0; k < active.size(); ++k) {
+      if (active[k].pid != pid) continue;
+      Job job = active[k];
+      active.erase(active.begin() + static_cast<std::ptrdiff_t>(k));
+      const bool ok = WIFEXITED(status) && WEXITSTATUS(status) == 0;
+      if (!ok) {
+        ++result.runs_failed;
+        failures.push_back(job.dir + (job.stage == 0 ? ": run" : ": evaluate") +
+                           " failed, see " + job.dir + ".log");
+      } else if (job.stage == 0 && options.evaluate_runs) {
+        job.stage = 1;
+        start(&job);
+        active.push_back(job);
+        ++result.runs_made;
+      } else if (job.stage == 0) {
+        ++result.runs_made;
+      } else if (options.verbose) {
+        std::fprintf(stderr, "%s: done\n", job.dir.c_str());
+      }
+      break;
+    }
+  }
+  if (!failures.empty()) {
+    std::string message = "sweep: " + std::to_string(failures.size()) + " of " +
+                          std::to_string(options.runs) + " runs failed:";
+    for (const std::string& f : failures) message += "\n  " + f;
+    throw std::runtime_error(message);
+  }
+  result.summary = AggregateSweep(run_dirs, dir, options);
+  result.summary["sweep"]["runs_made"] = result.runs_made;
+  result.summary["sweep"]["runs_kept"] = result.runs_kept;
+  result.summary["sweep"]["base_seed"] = config.run.seed;
+  result.summary["sweep"]["jobs"] = jobs;
+  WriteJsonAtomically(dir + "/summary.json", result.summary);
+  if (!options.divergence_study_points.empty()) {
+    WriteDivergenceStudy(run_dirs.front(), options.divergence_study_points,
+                         options.divergence_study_realisations, dir + "/divergence.csv");
+  }
+  return result;
+}
+
+nlohmann::json AggregateSweep(const std::vector<std::string>& run_dirs, const std::string& out_dir,
+                              const SweepOptions& options) {
+  const std::vector<std::string>& names = FilterNames();
+  // Per run and filter: the NEES of every step; the times; the summaries.
+  std::vector<std::vector<std::vector<double>>> nees(names.size());
+  std::vector<std::vector<double>> times;
+  std::vector<std::vector<double>> processing_s(names.size());
+  std::vector<std::vector<double>> open_loop_s(names.size());
+  std::vector<std::vector<double>> max_period_s(names.size());
+  std::vector<nlohmann::json> summaries;
+  for (const std::string& run_dir : run_dirs) {
+    const CsvTable table = ReadCsv(run_dir + "/trajectory.csv");
+    const int t = table.ColumnIndex("t");
+    std::vector<double> run_times;
+    for (const std::vector<double>& row : table.rows) run_times.push_back(row[t]);
+    times.push_back(run_times);
+    const double dt = run_times.size() > 1 ? run_times[1] - run_times[0] : 0.0;
+    for (std::size_t f = 0; f < names.size(); ++f) {
+      nees[f].push_back(PoseNees(table, names[f]));
+      const int us = table.ColumnIndex(names[f] + "_us");
+      double total_us = 0.0;
+      for (const std::vector<double>& row : table.rows) total_us += row[us];
+      processing_s[f].push_back(total_us * 1e-6);
+      // Open loop: the time each step holds its command beyond one period.
+      for (std::size_t c = 0; c < table.columns.size(); ++c) {
+        if (table.columns[c] != names[f] + "_period") continue;
+        double open = 0.0;
+        double longest = 0.0;
+        for (const std::vector<double>& row : table.rows) {
+          open += std::max(0.0, row[c] - dt);
+          longest = std::max(longest, row[c]);
+        }
+        open_loop_s[f].push_back(open);
+        max_period_s[f].push_back(longest);
+      }
+    }
+    summaries.push_back(ReadJsonFile(run_dir + "/summary.json", nlohmann::json::object()));
+  }
+
+  // Per step: average NEES over the runs that reach it, when every such run
+  // has both filters' NEES (the known start has none).
+  std::size_t num_steps = 0;
+  for (const std::vector<double>& run_times : times) num_steps = std::max(num_steps, run_times.size());
+  std::string csv = "t,classical_anees,selective_anees,lower,upper,n_runs\n";
+  std::vector<int> inside(names.size(), 0);
+  std::vector<int> above(names.size(), 0);
+  std::vector<int> below(names.size(), 0);
+  std::vector<double> anees_sum(names.size(), 0.0);
+  int used_steps = 0;
+  for (std::size_t k = 0; k < num_steps; ++k) {
+    int n = 0;
+    double t = kNaN;
+    bool defined = true;
+    std::vector<double> sum(names.size(), 0.0);
+    for (std::size_t r = 0; r < run_dirs.size(); ++r) {
+      if (k >= times[r].size()) continue;
+      if (n == 0) t = times[r][k];
+      ++n;
+      for (std::size_t f = 0; f < names.size(); ++f) {
+        const double v = nees[f][r][k];
+        if (!std::isfinite(v)) defined = false;
+        sum[f] += v;
+      }
+    }
+    if (n == 0 || !defined) continue;
+    ++used_steps;
+    const eval::Interval bounds = eval::AverageNeesBounds(n, 3, options.bounds_probability);
+    csv += FormatDouble(t);
+    for (std::size_t f = 0; f < names.size(); ++f) {
+      const double anees = sum[f] / n;
+      anees_sum[f] += anees;
+      if (anees < bounds.lower) ++below[f];
+      else if (anees > bounds.upper) ++above[f];
+      else ++inside[f];
+      csv += "," + FormatDouble(anees);
+    }
+    csv += "," + FormatDouble(bounds.lower) + "," + FormatDouble(bounds.upper) + "," +
+           std::to_string(n) + "\n";
+  }
+  WriteFileAtomically(out_dir + "/nees.csv", csv);
+
+  nlohmann::json summary;
+  summary["sweep"] = {{"completed_runs", static_cast<int>(run_dirs.size())},
+                      {"steps", used_steps},
+                      {"bounds", {{"probability", options.bounds_probability}, {"dof", 3}}},
+                      {"min_fraction_inside", options.min_fraction_inside}};
+  auto mean = [](const std::vector<double>& v) {
+    if (v.empty()) return nlohmann::json(nullptr);
+    double s = 0.0;
+    for (const double x : v) s += x;
+    return nlohmann::json(s / v.size());
+  };
+  for (std::size_t f = 0; f < names.size(); ++f) {
+    nlohmann::json j;
+    const double steps = std::max(used_steps, 1);
+    j["fraction_inside"] = inside[f] / steps;
+    j["fraction_above"] = above[f] / steps;
+    j["fraction_below"] = below[f] / steps;
+    j["mean_anees"] = used_steps > 0 ? nlohmann::json(anees_sum[f] / used_steps) : nlohmann::json(nullptr);
+    std::string verdict = "consistent";
+    if (used_steps == 0) verdict = "undetermined";
+    else if (inside[f] / steps < options.min_fraction_inside) {
+      verdict = above[f] >= below[f] ? "overconfident" : "underconfident";
+    }
+    j["verdict"] = verdict;
+    j["processing_s"] = mean(processing_s[f]);
+    // Only when every run has the period column.
+    j["open_loop_s"] = open_loop_s[f].size() == run_dirs.size() ? mean(open_loop_s[f]) : nullptr;
+    j["max_period_s"] = max_period_s[f].size() == run_dirs.size() && !run_dirs.empty()
+                            ? nlohmann::json(*std::max_element(max_period_s[f].begin(), max_period_s[f].end()))
+                            : nlohmann::json(nullptr);
+    // The mean over runs of each run's own metrics (mjslam evaluate).
+    const std::string base = "/filters/" + names[f];
+    for (const char* key : {"mean_nees"}) {
+      j["runs_mean"][key] = MeanOf(summaries, nlohmann::json::json_pointer(base + "/" + key));
+    }
+    for (const char* group : {"inside_2sigma", "rmse", "final_pose_error"}) {
+      for (const char* c : {"x", "y", "th"}) {
+        j["runs_mean"][group][c] =
+            MeanOf(summaries, nlohmann::json::json_pointer(base + "/" + group + "/" + c));
+      }
+    }
+    for (const char* key : {"num_estimates", "num_truth", "matched_estimates", "matched_truth",
+                            "matched_fraction", "duplicates", "unmatched_estimates",
+                            "inconsistent", "mean_feature_nees", "line_rho_rmse_m",
+                            "line_alpha_rmse_rad", "corner_rmse_m"}) {
+      j["runs_mean"]["map"][key] =
+          MeanOf(summaries, nlohmann::json::json_pointer(base + "/map/" + key));
+    }
+    summary["filters"][names[f]] = j;
+  }
+  // The mean of the runs' divergences, when they were evaluated with one.
+  for (const char* pair : {"classical_selective", "selective_classical", "classical_truth",
+                           "selective_truth"}) {
+    const nlohmann::json value =
+        MeanOf(summaries, nlohmann::json::json_pointer(std::string("/divergence/") + pair));
+    if (!value.is_null()) summary["divergence"]["runs_mean"][pair] = value;
+  }
+  return summary;
+}
+
+}  // namespace mjslam::app

@@ -1,0 +1,83 @@
+#pragma once
+
+#include <csignal>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "app/evaluate.h"
+#include "app/run_config.h"
+
+namespace mjslam::app {
+
+/// How `mjslam sweep` runs its Monte Carlo.
+struct SweepOptions {
+  /// Number of runs; run i has seed run.seed + i and lives in
+  /// out_dir/runs/run_<i, 3 digits>.
+  int runs = 1;
+  /// Runs at a time (separate processes); 0: one per core
+  /// (std::thread::hardware_concurrency()).
+  int jobs = 0;
+  /// The sweep directory.
+  std::string out_dir;
+  /// The mjslam program that runs (`run`) and evaluates (`evaluate`) each run.
+  std::string program;
+  /// Evaluate each run (`mjslam evaluate`); without it the aggregate has the
+  /// NEES and times but no per-run metrics (runs_mean).
+  bool evaluate_runs = true;
+  /// Divergence of each run's evaluation (`evaluate --divergence-points`);
+  /// 0: none.
+  int divergence_points = 0;
+  /// After the sweep, also write out_dir/divergence.csv from the first run
+  /// (`mjslam divergence` with these numbers of points and realisations;
+  /// empty: not).
+  std::vector<int> divergence_study_points;
+  int divergence_study_realisations = 100;
+  /// A verdict is "consistent" when at least this fraction of the steps have
+  /// the average NEES inside the bounds.
+  double min_fraction_inside = 0.9;
+  /// Probability of the two-sided average-NEES bounds.
+  double bounds_probability = 0.95;
+  /// Print one line per finished run to stderr.
+  bool verbose = true;
+  /// Set asynchronously (signal handler) to stop: running runs are stopped
+  /// (and redone by the next sweep), nothing is aggregated.
+  const volatile std::sig_atomic_t* stop_requested = nullptr;
+};
+
+/// What a sweep did.
+struct SweepResult {
+  /// Runs made now, runs kept from an earlier sweep, runs that failed.
+  int runs_made = 0;
+  int runs_kept = 0;
+  int runs_failed = 0;
+  bool interrupted = false;
+  /// The aggregate written to out_dir/summary.json.
+  nlohmann::json summary;
+};
+
+/// Runs a Monte Carlo sweep: `config` (already loaded, with its overrides) is
+/// written to out_dir/config.yaml, and run i is `program run --config
+/// out_dir/config.yaml --seed <run.seed + i> --out out_dir/runs/<name>`
+/// followed by `program evaluate`, `jobs` runs at a time. So each run's files
+/// are those of a single `mjslam run` with that seed. Resumable: a run whose
+/// manifest says completed is kept (and only evaluated if its summary lacks
+/// the metrics); any other is deleted and redone. A sweep directory made with
+/// another config is refused (std::runtime_error naming its config.yaml).
+/// Then aggregates (AggregateSweep). Throws std::runtime_error when a run or
+/// evaluation fails, after the other runs have finished.
+SweepResult RunSweep(const RunConfig& config, const SweepOptions& options);
+
+/// The aggregate of the completed runs `run_dirs` of a sweep: writes
+/// out_dir/nees.csv (t,classical_anees,selective_anees,lower,upper,n_runs:
+/// per step, the average pose NEES over the runs that have it and the
+/// two-sided bounds for n_runs) and returns the summary (README, "mjslam
+/// sweep"): per filter the fraction of steps inside, above and below the
+/// bounds, the mean ANEES, the verdict, accumulated processing time and
+/// (with f_period columns) open-loop time, and the mean of the runs' metrics.
+nlohmann::json AggregateSweep(const std::vector<std::string>& run_dirs, const std::string& out_dir,
+                              const SweepOptions& options);
+
+}  // namespace mjslam::app

@@ -1,0 +1,199 @@
+#include "eval/map_divergence.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <stdexcept>
+
+#include "common/angles.h"
+#include "common/check.h"
+
+namespace mjslam::eval {
+
+std::vector<ParamProblem> DivergenceParams::Validate() const {
+  ParamChecker check;
+  check.Positive("line_spacing_m", line_spacing_m);
+  check.Positive("floor_std_m", floor_std_m);
+  check.NonNegative("margin_m", margin_m);
+  return check.problems();
+}
+
+GaussianMixture MapToMixture(const Map& map, const DivergenceParams& params) {
+  params.ValidateOrThrow();
+  const Eigen::Matrix2d floor =
+      params.floor_std_m * params.floor_std_m * Eigen::Matrix2d::Identity();
+  // Features that become Gaussians, each with mass 1 / count.
+  int count = 0;
+  for (const MapFeature& f : map) {
+    if (f.type == MapFeature::Type::kCorner || f.has_segment) ++count;
+  }
+  GaussianMixture mixture;
+  for (const MapFeature& f : map) {
+    if (f.type == MapFeature::Type::kCorner) {
+      mixture.means.push_back(f.params);
+      mixture.covariances.push_back(f.covariance + floor);
+      mixture.weights.push_back(1.0 / count);
+      continue;
+    }
+    if (!f.has_segment) continue;
+    const double r = f.params.x();
+    const double al = f.params.y();
+    const Eigen::Vector2d n(std::cos(al), std::sin(al));
+    const Eigen::Vector2d t(-std::sin(al), std::cos(al));
+    const double s_a = t.dot(f.p_WA);
+    const double s_b = t.dot(f.p_WB);
+    const int num = std::max(2, static_cast<int>(std::ceil(std::abs(s_b - s_a) /
+                                                           params.line_spacing_m)) + 1);
+    for (int k = 0; k < num; ++k) {
+      const double s = s_a + (s_b - s_a) * k / (num - 1);
+      Eigen::Matrix2d J;
+      J.col(0) = n;
+      J.col(1) = r * t - s * n;
+      const Eigen::Matrix2d C = J * f.covariance * J.transpose();
+      mixture.means.push_back(r * n + s * t);
+      mixture.covariances.push_back(0.5 * (C + C.transpose()) + floor);
+      mixture.weights.push_back(1.0 / (static_cast<double>(count) * num));
+    }
+  }
+  return mixture;
+}
+
+Box CommonBoundingBox(const std::vector<const GaussianMixture*>& mixtures, double margin_m) {
+  Box box;
+  box.min.setConstant(std::numeric_limits<double>::infinity());
+  box.max.setConstant(-std::numeric_limits<double>::infinity());
+  for (const GaussianMixture* m : mixtures) {
+    for (const Eigen::Vector2d& p : m->means) {
+      box.min = box.min.cwiseMin(p);
+      box.max = box.max.cwiseMax(p);
+    }
+  }
+  MJSLAM_CHECK(box.min.allFinite() && box.max.allFinite());
+  box.min.array() -= margin_m;
+  box.max.array() += margin_m;
+  return box;
+}
+
+std::vector<Eigen::Vector2d> UniformPoints(const Box& box, int num_points, Rng* rng) {
+  std::vector<Eigen::Vector2d> points(static_cast<std::size_t>(std::max(num_points, 0)));
+  for (Eigen::Vector2d& p : points) {
+    const double u = rng->Uniform();
+    const double v = rng->Uniform();
+    p = {box.min.x() + u * (box.max.x() - box.min.x()),
+         box.min.y() + v * (box.max.y() - box.min.y())};
+  }
+  return points;
+}
+
+std::vector<double> LogPmf(const GaussianMixture& mixture,
+                           const std::vector<Eigen::Vector2d>& points) {
+  MJSLAM_CHECK(!mixture.means.empty());
+  // Per Gaussian: log(weight / (2 pi sqrt(det C))) and the inverse of C.
+  const std::size_t num = mixture.means.size();
+  std::vector<double> log_scale(num);
+  std::vector<Eigen::Vector3d> inverse(num);  // (a, b, c) of [[a, b], [b, c]]
+  for (std::size_t k = 0; k < num; ++k) {
+    const Eigen::Matrix2d& C = mixture.covariances[k];
+    const double det = C(0, 0) * C(1, 1) - C(0, 1) * C(1, 0);
+    MJSLAM_CHECK(det > 0.0);
+    inverse[k] = {C(1, 1) / det, -C(0, 1) / det, C(0, 0) / det};
+    log_scale[k] = std::log(mixture.weights[k]) - std::log(2.0 * kPi) - 0.5 * std::log(det);
+  }
+  std::vector<double> log_density(points.size());
+  std::vector<double> terms(num);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    double largest = -std::numeric_limits<double>::infinity();
+    for (std::size_t k = 0; k < num; ++k) {
+      const double dx = points[i].x() - mixture.means[k].x();
+      const double dy = points[i].y() - mixture.means[k].y();
+      const Eigen::Vector3d& w = inverse[k];
+      terms[k] = log_scale[k] - 0.5 * (w(0) * dx * dx + 2.0 * w(1) * dx * dy + w(2) * dy * dy);
+      largest = std::max(largest, terms[k]);
+    }
+    // Terms more than 40 below the largest add less than 1e-17 of it.
+    double sum = 0.0;
+    const double cutoff = largest - 40.0;
+    for (std::size_t k = 0; k < num; ++k) {
+      if (terms[k] > cutoff) sum += std::exp(terms[k] - largest);
+    }
+    log_density[i] = largest + std::log(sum);
+  }
+  // Normalise over the points, also in log space.
+  double largest = -std::numeric_limits<double>::infinity();
+  for (const double l : log_density) largest = std::max(largest, l);
+  double sum = 0.0;
+  for (const double l : log_density) sum += std::exp(l - largest);
+  const double log_total = largest + std::log(sum);
+  for (double& l : log_density) l -= log_total;
+  return log_density;
+}
+
+double KlDivergence(const std::vector<double>& log_p, const std::vector<double>& log_q) {
+  MJSLAM_CHECK(log_p.size() == log_q.size());
+  double d = 0.0;
+  for (std::size_t i = 0; i < log_p.size(); ++i) d += std::exp(log_p[i]) * (log_p[i] - log_q[i]);
+  return d;
+}
+
+MapDivergences ComputeMapDivergences(const GaussianMixture& classical,
+                                     const GaussianMixture& selective,
+                                     const GaussianMixture& truth, int num_points, Rng* rng,
+                                     const DivergenceParams& params) {
+  params.ValidateOrThrow();
+  const Box box = CommonBoundingBox({&classical, &selective, &truth}, params.margin_m);
+  const std::vector<Eigen::Vector2d> points = UniformPoints(box, num_points, rng);
+  const std::vector<double> c = LogPmf(classical, points);
+  const std::vector<double> s = LogPmf(selective, points);
+  const std::vector<double> t = LogPmf(truth, points);
+  return {KlDivergence(c, s), KlDivergence(s, c), KlDivergence(c, t), KlDivergence(s, t)};
+}
+
+std::vector<DivergenceStatistics> DivergenceStudy(const Map& classical, const Map& selective,
+                                                  const Map& truth,
+                                                  const std::vector<int>& num_points,
+                                                  int realisations, const Rng& rng,
+                                                  const DivergenceParams& params) {
+  if (realisations < 1) {
+    throw std::invalid_argument("divergence: realisations must be >= 1 (got " +
+                                std::to_string(realisations) + ")");
+  }
+  const GaussianMixture c = MapToMixture(classical, params);
+  const GaussianMixture s = MapToMixture(selective, params);
+  const GaussianMixture t = MapToMixture(truth, params);
+  for (const auto* m : {&c, &s, &t}) {
+    if (m->means.empty()) {
+      throw std::invalid_argument("divergence: a map has no corner and no line with a segment");
+    }
+  }
+  std::vector<DivergenceStatistics> rows;
+  for (const int e : num_points) {
+    if (e < 1) {
+      throw std::invalid_argument("divergence: number of points must be >= 1 (got " +
+                                  std::to_string(e) + ")");
+    }
+    std::vector<MapDivergences> samples;
+    for (int k = 0; k < realisations; ++k) {
+      Rng stream = rng.Fork("divergence/" + std::to_string(e) + "/" + std::to_string(k));
+      samples.push_back(ComputeMapDivergences(c, s, t, e, &stream, params));
+    }
+    const char* names[4] = {"classical_selective", "selective_classical", "classical_truth",
+                            "selective_truth"};
+    for (int p = 0; p < 4; ++p) {
+      auto value = [p](const MapDivergences& d) {
+        const double v[4] = {d.classical_selective, d.selective_classical, d.classical_truth,
+                             d.selective_truth};
+        return v[p];
+      };
+      double mean = 0.0;
+      for (const MapDivergences& d : samples) mean += value(d);
+      mean /= realisations;
+      double variance = 0.0;
+      for (const MapDivergences& d : samples) variance += std::pow(value(d) - mean, 2);
+      variance = realisations > 1 ? variance / (realisations - 1) : 0.0;
+      rows.push_back({e, names[p], mean, variance});
+    }
+  }
+  return rows;
+}
+
+}  // namespace mjslam::eval

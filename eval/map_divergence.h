@@ -1,0 +1,109 @@
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "common/params.h"
+#include "common/rng.h"
+#include "eval/map_types.h"
+
+namespace mjslam::eval {
+
+/// How a map becomes a probability mass function (method.md, item 4).
+struct DivergenceParams {
+  /// Lines become Gaussians spaced at most this far apart along their
+  /// segment (at least two per line), metres.
+  double line_spacing_m = 0.05;
+  /// Standard deviation added in quadrature to every Gaussian, metres: the
+  /// ground truth's features (zero covariance) become near-degenerate
+  /// Gaussians of this size, and estimated ones never get thinner.
+  double floor_std_m = 0.02;
+  /// The bounding box of the Gaussians' means is grown by this on every side
+  /// before the points are drawn in it, metres.
+  double margin_m = 0.5;
+
+  std::vector<ParamProblem> Validate() const;
+  void ValidateOrThrow() const { ThrowIfProblems(Validate(), "divergence"); }
+};
+
+/// A map as a weighted sum of 2-D Gaussians in W (Eq. 23 of the paper).
+struct GaussianMixture {
+  std::vector<Eigen::Vector2d> means;
+  std::vector<Eigen::Matrix2d> covariances;
+  /// Sum to 1 (each feature 1 / number of features, a line's split evenly
+  /// over its Gaussians).
+  std::vector<double> weights;
+};
+
+/// The mixture of a map. A corner is one Gaussian at its point with its
+/// covariance (+ floor). A line with a segment becomes Gaussians at evenly
+/// spaced positions s along it, p(s) = r n + s t (n = (cos al, sin al),
+/// t = (-sin al, cos al)), each with covariance J C J^T + floor, J = dp /
+/// d(r, al) = [n, r t - s n] at fixed s; lines without a segment are left
+/// out. Throws ParamError for invalid params.
+GaussianMixture MapToMixture(const Map& map, const DivergenceParams& params = {});
+
+/// An axis-aligned box in W, metres.
+struct Box {
+  Eigen::Vector2d min = Eigen::Vector2d::Zero();
+  Eigen::Vector2d max = Eigen::Vector2d::Zero();
+};
+
+/// The box around every mixture's means, grown by `margin_m`. At least one
+/// mixture must have a Gaussian (checked).
+Box CommonBoundingBox(const std::vector<const GaussianMixture*>& mixtures, double margin_m);
+
+/// `num_points` points drawn uniformly in `box` from `rng`.
+std::vector<Eigen::Vector2d> UniformPoints(const Box& box, int num_points, Rng* rng);
+
+/// The log of the mixture's probability mass function over `points` (Eqs.
+/// 19-22): log density at each point, normalised so that the masses sum to
+/// 1, computed in log space (log-sum-exp), so far points keep a finite log.
+std::vector<double> LogPmf(const GaussianMixture& mixture,
+                           const std::vector<Eigen::Vector2d>& points);
+
+/// Kullback-Leibler divergence D(p || q) = sum_i p_i log(p_i / q_i) (Eq. 18)
+/// of two pmfs given by their logs over the same points (sizes checked).
+double KlDivergence(const std::vector<double>& log_p, const std::vector<double>& log_q);
+
+/// The four divergences of one realisation, nats: between the two filters'
+/// maps in both orders and from each to the ground truth.
+struct MapDivergences {
+  double classical_selective = 0.0;  // D(classical || selective)
+  double selective_classical = 0.0;  // D(selective || classical)
+  double classical_truth = 0.0;      // D(classical || truth)
+  double selective_truth = 0.0;      // D(selective || truth)
+};
+
+/// One realisation: `num_points` points uniform in the common bounding box of
+/// the three maps (grown by margin_m), drawn from `rng`.
+MapDivergences ComputeMapDivergences(const GaussianMixture& classical,
+                                     const GaussianMixture& selective,
+                                     const GaussianMixture& truth, int num_points, Rng* rng,
+                                     const DivergenceParams& params = {});
+
+/// Mean and variance (unbiased, over the realisations) of one pair's
+/// divergence at one number of points: a row of divergence.csv.
+struct DivergenceStatistics {
+  int num_points = 0;
+  /// "classical_selective", "selective_classical", "classical_truth" or
+  /// "selective_truth".
+  std::string pair;
+  double mean = 0.0;
+  double variance = 0.0;
+};
+
+/// The paper's Figs. 6 and 7: for each entry of `num_points`,
+/// `realisations` independent realisations (realisation k at E points draws
+/// from rng.Fork("divergence/E/k"), so every number is reproducible on its
+/// own). Rows in the order of `num_points`, then of the pairs above.
+/// realisations >= 1 and every num_points >= 1 (throw std::invalid_argument).
+std::vector<DivergenceStatistics> DivergenceStudy(const Map& classical, const Map& selective,
+                                                  const Map& truth,
+                                                  const std::vector<int>& num_points,
+                                                  int realisations, const Rng& rng,
+                                                  const DivergenceParams& params = {});
+
+}  // namespace mjslam::eval

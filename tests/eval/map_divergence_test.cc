@@ -1,0 +1,140 @@
+// The paper's map divergence: mixtures, pmfs and Kullback-Leibler divergence.
+#include "eval/map_divergence.h"
+
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "common/angles.h"
+#include "eval/ground_truth.h"
+
+namespace mjslam::eval {
+namespace {
+
+// The inner walls of an 8 x 6 m room as a ground truth map.
+Map Room() {
+  auto box = [](double x0, double y0, double x1, double y1) {
+    return WallRectangle{{Eigen::Vector2d(x0, y0), Eigen::Vector2d(x1, y0),
+                          Eigen::Vector2d(x1, y1), Eigen::Vector2d(x0, y1)}};
+  };
+  return BuildGroundTruthMap({box(-4.15, -3.15, 4.15, -3.0), box(4.0, -3.15, 4.15, 3.15),
+                              box(-4.15, 3.0, 4.15, 3.15), box(-4.15, -3.15, -4.0, 3.15)});
+}
+
+// `map` with every feature moved by `offset` and given covariance `var` I.
+Map Shifted(const Map& map, const Eigen::Vector2d& offset, double var) {
+  Map out = map;
+  for (MapFeature& f : out) {
+    f.covariance = var * Eigen::Matrix2d::Identity();
+    if (f.type == MapFeature::Type::kCorner) {
+      f.params += offset;
+      continue;
+    }
+    const Eigen::Vector2d n(std::cos(f.params.y()), std::sin(f.params.y()));
+    f.params.x() += n.dot(offset);
+    f.p_WA += offset;
+    f.p_WB += offset;
+  }
+  return out;
+}
+
+TEST(MapDivergenceTest, MixtureOfALinePropagatesItsCovariance) {
+  MapFeature line;
+  line.type = MapFeature::Type::kLine;
+  line.params = {2.0, 0.0};  // x = 2
+  line.covariance = Eigen::Vector2d(1e-4, 1e-6).asDiagonal();
+  line.has_segment = true;
+  line.p_WA = {2.0, -1.0};
+  line.p_WB = {2.0, 1.0};
+  DivergenceParams params;
+  params.line_spacing_m = 0.5;
+  const GaussianMixture m = MapToMixture({line}, params);
+  ASSERT_EQ(m.means.size(), 5u);  // s = -1, -0.5, 0, 0.5, 1
+  double total = 0.0;
+  for (const double w : m.weights) total += w;
+  EXPECT_NEAR(total, 1.0, 1e-12);
+  // At s = 1 (the point (2, 1)): J = [n, r t - s n] = [[1, -1], [0, 2]].
+  EXPECT_NEAR((m.means[4] - Eigen::Vector2d(2.0, 1.0)).norm(), 0.0, 1e-12);
+  Eigen::Matrix2d J;
+  J << 1.0, -1.0, 0.0, 2.0;
+  const Eigen::Matrix2d expected = J * line.covariance * J.transpose() +
+                                   params.floor_std_m * params.floor_std_m * Eigen::Matrix2d::Identity();
+  EXPECT_NEAR((m.covariances[4] - expected).norm(), 0.0, 1e-15);
+  // The propagated covariance against central differences of p(r, al) at s.
+  const double s = 1.0;
+  auto point = [s](double r, double al) {
+    return Eigen::Vector2d(r * std::cos(al) - s * std::sin(al), r * std::sin(al) + s * std::cos(al));
+  };
+  const double h = 1e-6;
+  Eigen::Matrix2d numeric;
+  numeric.col(0) = (point(2.0 + h, 0.0) - point(2.0 - h, 0.0)) / (2 * h);
+  numeric.col(1) = (point(2.0, h) - point(2.0, -h)) / (2 * h);
+  EXPECT_NEAR((numeric - J).norm(), 0.0, 1e-8);
+}
+
+TEST(MapDivergenceTest, PmfSumsToOneAndDivergenceOfAMapWithItselfIsZero) {
+  const GaussianMixture truth = MapToMixture(Room());
+  Rng rng(11);
+  const Box box = CommonBoundingBox({&truth}, 0.5);
+  const std::vector<Eigen::Vector2d> points = UniformPoints(box, 2000, &rng);
+  for (const Eigen::Vector2d& p : points) {
+    ASSERT_TRUE(p.x() >= box.min.x() && p.x() <= box.max.x());
+    ASSERT_TRUE(p.y() >= box.min.y() && p.y() <= box.max.y());
+  }
+  const std::vector<double> log_p = LogPmf(truth, points);
+  double total = 0.0;
+  for (const double l : log_p) {
+    ASSERT_TRUE(std::isfinite(l));
+    total += std::exp(l);
+  }
+  EXPECT_NEAR(total, 1.0, 1e-12);
+  EXPECT_NEAR(KlDivergence(log_p, log_p), 0.0, 1e-15);
+}
+
+TEST(MapDivergenceTest, DivergenceGrowsWithTheMapErrorAndIsAsymmetric) {
+  // Seed 5: a map 1 cm off the truth is closer than one 5 cm off, in every
+  // realisation; D(a||b) != D(b||a) in general; all divergences >= 0.
+  const Map truth = Room();
+  const GaussianMixture t = MapToMixture(truth);
+  const GaussianMixture near = MapToMixture(Shifted(truth, {0.01, 0.0}, 1e-4));
+  const GaussianMixture far = MapToMixture(Shifted(truth, {0.05, -0.02}, 4e-4));
+  const Rng root(5);
+  for (int k = 0; k < 5; ++k) {
+    Rng rng = root.Fork("r" + std::to_string(k));
+    const MapDivergences d = ComputeMapDivergences(near, far, t, 2000, &rng);
+    EXPECT_LT(d.classical_truth, d.selective_truth) << k;
+    EXPECT_GE(d.classical_truth, 0.0);
+    EXPECT_GT(d.classical_selective, 0.0);
+    EXPECT_GT(d.selective_classical, 0.0);
+    EXPECT_NE(d.classical_selective, d.selective_classical);
+  }
+}
+
+TEST(MapDivergenceTest, StudyIsReproducibleRowByRow) {
+  const Map truth = Room();
+  const Map a = Shifted(truth, {0.02, 0.0}, 1e-4);
+  const Map b = Shifted(truth, {0.0, 0.03}, 2e-4);
+  const Rng rng(3);
+  const std::vector<DivergenceStatistics> first = DivergenceStudy(a, b, truth, {100, 1000}, 5, rng);
+  const std::vector<DivergenceStatistics> second = DivergenceStudy(a, b, truth, {100, 1000}, 5, rng);
+  ASSERT_EQ(first.size(), 8u);
+  for (std::size_t i = 0; i < first.size(); ++i) {
+    EXPECT_EQ(first[i].mean, second[i].mean);  // bit for bit
+    EXPECT_EQ(first[i].variance, second[i].variance);
+  }
+  EXPECT_EQ(first[0].pair, "classical_selective");
+  EXPECT_EQ(first[3].pair, "selective_truth");
+  EXPECT_EQ(first[4].num_points, 1000);
+  // Each #E has its own streams: a study of 1000 points alone gives the same.
+  const std::vector<DivergenceStatistics> alone = DivergenceStudy(a, b, truth, {1000}, 5, rng);
+  for (int p = 0; p < 4; ++p) EXPECT_EQ(alone[p].mean, first[4 + p].mean);
+  for (const DivergenceStatistics& row : first) {
+    EXPECT_GT(row.mean, 0.0);
+    EXPECT_GT(row.variance, 0.0);
+  }
+  EXPECT_THROW(DivergenceStudy(a, b, truth, {0}, 2, rng), std::invalid_argument);
+  EXPECT_THROW(DivergenceStudy(a, b, truth, {10}, 0, rng), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace mjslam::eval
