@@ -6,6 +6,7 @@
 
 #include "common/params.h"
 #include "explorer/waypoint_driver.h"
+#include "renders/render_params.h"
 #include "sim/sim_params.h"
 #include "slam/slam_params.h"
 
@@ -47,6 +48,8 @@ struct RunConfig {
   sim::OdometryParams odometry;
   explorer::WaypointDriverParams driver;
   slam::SlamParams slam;
+  /// Renders at the end of a completed `mjslam run` (renders/).
+  renders::RenderParams render;
 
   template <typename Archive>
   void Serialize(Archive* a) {
@@ -57,6 +60,7 @@ struct RunConfig {
     a->Visit(MJSLAM_NVP(odometry));
     a->Visit(MJSLAM_NVP(driver));
     a->Visit(MJSLAM_NVP(slam));
+    a->Visit(MJSLAM_NVP(render));
   }
   std::vector<ParamProblem> Validate() const;
   void ValidateOrThrow() const { ThrowIfProblems(Validate()); }
