@@ -30,9 +30,9 @@ struct RenderParams {
   /// x264's default).
   int crf = 23;
   /// The 2-sigma position ellipses are drawn this many times their size
-  /// (they are centimetres across; a pixel covers a few centimetres). The
-  /// legend states the factor.
-  double ellipse_scale = 10.0;
+  /// (they are millimetres to centimetres across; a pixel of a 640 x 480
+  /// view of a 13 m world covers 2-3 cm). The legend states the factor.
+  double ellipse_scale = 100.0;
 
   template <typename Archive>
   void Serialize(Archive* a) {

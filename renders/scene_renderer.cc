@@ -94,19 +94,32 @@ struct SceneRenderer::Impl {
     return scn.geoms + scn.ngeom++;
   }
 
+  // A flat bar from a to b, `width_px` pixels wide, at height z: a box,
+  // since OpenGL line widths are not under MuJoCo's control.
   void AddSegment(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double z, const Rgb& color,
                   double width_px) {
     mjvGeom* g = NewGeom();
     if (g == nullptr) return;
     const float rgba[4] = {color[0], color[1], color[2], 1.0f};
-    mjv_initGeom(g, mjGEOM_LINE, nullptr, nullptr, nullptr, rgba);
     mjtNum pa[3], pb[3];
     Lift(a, z, pa);
     Lift(b, z, pb);
-    mjv_makeConnector(g, mjGEOM_LINE, width_px, pa[0], pa[1], pa[2], pb[0], pb[1], pb[2]);
+    const double dx = pb[0] - pa[0], dy = pb[1] - pa[1];
+    const double half_width = 0.5 * width_px * PixelM();
+    // Overlap the joints of a polyline by half a width at each end.
+    const mjtNum size[3] = {0.5 * std::hypot(dx, dy) + half_width, half_width, 0.002};
+    const mjtNum pos[3] = {0.5 * (pa[0] + pb[0]), 0.5 * (pa[1] + pb[1]), z};
+    const double angle = std::atan2(dy, dx);
+    const double c = std::cos(angle), s = std::sin(angle);
+    const mjtNum mat[9] = {c, -s, 0, s, c, 0, 0, 0, 1};
+    mjv_initGeom(g, mjGEOM_BOX, size, pos, mat, rgba);
     g->category = mjCAT_DECOR;
-    g->emission = 1.0f;
+    g->emission = 0.0f;
+    g->specular = 0.0f;
   }
+
+  // Metres of floor per pixel.
+  double PixelM() const { return 2.0 * half_height_m / height; }
 
   void AddPolyline(const std::vector<Eigen::Vector2d>& points, double z, const Rgb& color,
                    double width_px) {
@@ -125,7 +138,7 @@ struct SceneRenderer::Impl {
     const mjtNum size[3] = {half_m, half_m, 0.005};
     mjv_initGeom(g, mjGEOM_BOX, size, pos, nullptr, rgba);
     g->category = mjCAT_DECOR;
-    g->emission = 1.0f;
+    g->emission = 0.0f;
     g->specular = 0.0f;
   }
 
@@ -150,7 +163,7 @@ struct SceneRenderer::Impl {
       points.push_back(center + k * (std::sqrt(l1) * std::cos(phi) * u +
                                      std::sqrt(l2) * std::sin(phi) * v));
     }
-    AddPolyline(points, z, color, 2.0);
+    AddPolyline(points, z, color, 2.5);
   }
 
   void DrawLegend(const SceneFrame& frame);
@@ -199,8 +212,13 @@ SceneRenderer::SceneRenderer(const std::string& world_path, const std::string& r
   r.m->vis.quality.numslices = 16;
   r.m->vis.quality.numstacks = 8;
   r.m->vis.quality.numquads = 1;
-  r.m->vis.headlight.ambient[0] = r.m->vis.headlight.ambient[1] = r.m->vis.headlight.ambient[2] = 0.4f;
-  r.m->vis.headlight.diffuse[0] = r.m->vis.headlight.diffuse[1] = r.m->vis.headlight.diffuse[2] = 0.6f;
+  // Only the headlight, so that a face seen from above shows its own colour
+  // (ambient + diffuse = 1): colours in the image are those of colors::.
+  for (int i = 0; i < r.m->nlight; ++i) r.m->light_active[i] = 0;
+  r.m->vis.headlight.ambient[0] = r.m->vis.headlight.ambient[1] = r.m->vis.headlight.ambient[2] = 0.5f;
+  r.m->vis.headlight.diffuse[0] = r.m->vis.headlight.diffuse[1] = r.m->vis.headlight.diffuse[2] = 0.5f;
+  r.m->vis.headlight.specular[0] = r.m->vis.headlight.specular[1] = r.m->vis.headlight.specular[2] = 0.0f;
+  r.m->vis.headlight.active = 1;
 
   // Plain colours (textures cost time in software rendering): a light floor,
   // dark grey walls, so that the paths and the map stand out, and a red
@@ -345,14 +363,20 @@ Image SceneRenderer::Render(const SceneFrame& frame) {
     }
     if (frame.explorer->goal) r.AddMarker(*frame.explorer->goal, kFloorLayerZ + 0.01, 4.0 * pixel_m, colors::kGoal);
   }
-  r.AddPolyline(frame.true_path, kFloorLayerZ + 0.02, colors::kTruth, 2.0);
-  for (std::size_t i = 0; i < frame.filters.size(); ++i) {
-    r.AddPolyline(frame.filters[i].path, kFloorLayerZ + 0.03 + 0.01 * i, frame.filters[i].color, 2.0);
+  // The estimates and the truth often overlap: the first filter is drawn
+  // widest, the next narrower on top, the truth thinnest on top of all, so
+  // each stays visible as a stripe of its own.
+  const std::size_t n = frame.filters.size();
+  auto width_of = [n](std::size_t i) { return 2.0 + 2.0 * static_cast<double>(n - i); };
+  for (std::size_t i = 0; i < n; ++i) {
+    r.AddPolyline(frame.filters[i].path, kFloorLayerZ + 0.01 * (i + 1), frame.filters[i].color, width_of(i));
   }
-  for (std::size_t i = 0; i < frame.filters.size(); ++i) {
+  r.AddPolyline(frame.true_path, kFloorLayerZ + 0.01 * (n + 1), colors::kTruth, 1.5);
+  for (std::size_t i = 0; i < n; ++i) {
     const FilterLayer& f = frame.filters[i];
-    for (const Segment2& s : f.lines) r.AddSegment(s.a, s.b, kMapLayerZ + 0.01 * i, f.color, 3.0);
-    for (const Eigen::Vector2d& p : f.corners) r.AddMarker(p, kMapLayerZ + 0.01 * i, 2.5 * pixel_m, f.color);
+    for (const Segment2& s : f.lines) r.AddSegment(s.a, s.b, kMapLayerZ + 0.005 * i, f.color, width_of(i));
+    const double half_m = (1.5 + 1.5 * static_cast<double>(n - i)) * pixel_m;
+    for (const Eigen::Vector2d& p : f.corners) r.AddMarker(p, kMapLayerZ + 0.005 * i, half_m, f.color);
   }
   for (const Eigen::Vector2d& p : frame.laser_hits) r.AddMarker(p, kHitLayerZ, 1.0 * pixel_m, colors::kLaserHits);
   for (std::size_t i = 0; i < frame.filters.size(); ++i) {
@@ -404,18 +428,23 @@ void SceneRenderer::Impl::DrawLegend(const SceneFrame& frame) {
   const int swatch = con.charHeight - 2;
   const int x0 = panel.left + 8 * fontscale / 100;
   int y = height - 10 * fontscale / 100 - line_height;
-  auto text_at = [&](const std::string& text, int px, int py, const Rgb& color) {
-    mjr_text(mjFONT_NORMAL, text.c_str(), &con, static_cast<float>(px) / width,
-             static_cast<float>(py) / height, color[0], color[1], color[2]);
+  // Each entry: a swatch and its name, left-aligned by padding the label
+  // (mjr_label centres its text).
+  const int label_left = x0 + swatch + 6 * fontscale / 100;
+  const int label_width = panel.left + panel.width - label_left - 4;
+  auto label_at = [&](const std::string& text, int left, int bottom, int label_w) {
+    mjr_label({left, bottom, label_w, line_height}, mjFONT_NORMAL, text.c_str(), 1.0f, 1.0f, 1.0f, 1.0f,
+              0.0f, 0.0f, 0.0f, &con);
   };
   for (const Entry& e : entries) {
-    mjr_rectangle({x0, y + 2, swatch, swatch}, e.color[0], e.color[1], e.color[2], 1.0f);
-    text_at(e.text, x0 + swatch + 6 * fontscale / 100, y + 2, {0.0f, 0.0f, 0.0f});
+    mjr_rectangle({x0, y + (line_height - swatch) / 2, swatch, swatch}, e.color[0], e.color[1],
+                  e.color[2], 1.0f);
+    label_at(e.text, label_left, y, label_width);
     y -= line_height;
   }
   char scale_text[64];
-  std::snprintf(scale_text, sizeof(scale_text), "ellipses: 2 sigma x%g", frame.ellipse_scale);
-  text_at(scale_text, x0, y, {0.0f, 0.0f, 0.0f});
+  std::snprintf(scale_text, sizeof(scale_text), "ellipses 2sd x%g", frame.ellipse_scale);
+  label_at(scale_text, x0, y, panel.left + panel.width - x0 - 4);
 }
 
 }  // namespace mjslam::renders
