@@ -168,6 +168,8 @@ int main(int argc, char** argv) {
     }
   } catch (const std::exception& error) {
     std::fprintf(stderr, "mjslam: error:\n%s\n", error.what());
+    // A render stopped by Ctrl-C or SIGTERM is an interrupt, not a failure.
+    if (g_stop_requested != 0) return 130;
     return 1;
   }
   return 0;

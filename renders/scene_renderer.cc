@@ -445,6 +445,24 @@ void SceneRenderer::Impl::DrawLegend(const SceneFrame& frame) {
   char scale_text[64];
   std::snprintf(scale_text, sizeof(scale_text), "ellipses 2sd x%g", frame.ellipse_scale);
   label_at(scale_text, x0, y, panel.left + panel.width - x0 - 4);
+  y -= line_height;
+
+  // A scale bar: the largest whole number of metres (1, 2 or 5 times a
+  // power of ten) that fits in the swatch column plus half the panel.
+  const double pixels_per_m = 1.0 / PixelM();
+  const double fit_m = (0.5 * legend_width) / pixels_per_m;
+  double bar_m = std::pow(10.0, std::floor(std::log10(fit_m)));
+  if (5.0 * bar_m <= fit_m) {
+    bar_m *= 5.0;
+  } else if (2.0 * bar_m <= fit_m) {
+    bar_m *= 2.0;
+  }
+  const int bar_px = static_cast<int>(std::lround(bar_m * pixels_per_m));
+  y -= line_height / 2;
+  mjr_rectangle({x0, y + line_height / 2 - 2, bar_px, 4}, 0.0f, 0.0f, 0.0f, 1.0f);
+  char bar_text[32];
+  std::snprintf(bar_text, sizeof(bar_text), "%g m", bar_m);
+  label_at(bar_text, x0 + bar_px + 4, y, panel.left + panel.width - (x0 + bar_px + 4) - 4);
 }
 
 }  // namespace mjslam::renders
