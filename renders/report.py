@@ -22,6 +22,7 @@ import matplotlib
 
 matplotlib.use("Agg")  # no display
 import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.ticker  # noqa: E402
 
 # The renders' colours (renders/scene_renderer.h, namespace colors).
 COLORS = {"truth": "#0d0d0d", "classical": "#ff8000", "selective": "#0066ff"}
@@ -156,9 +157,14 @@ def plot_nees(nees, path):
     ax.set_xlabel("time (s)")
     ax.set_ylabel("average pose NEES (3 dof)")
     ax.set_yscale("log")
+    # Plain numbers on the log axis (not 4x10^0).
+    plain = matplotlib.ticker.FuncFormatter(lambda value, _: f"{value:g}")
+    ax.yaxis.set_major_formatter(plain)
+    ax.yaxis.set_minor_formatter(plain)
+    ax.tick_params(axis="y", which="minor", labelsize=7)
     ax.set_title(f"Average NEES over {int(max(n_runs)) if n_runs else 0} runs")
     ax.grid(True, alpha=0.3, which="both")
-    ax.legend(loc="upper left")
+    ax.legend(loc="best")
     fig.tight_layout()
     save(fig, path)
 
