@@ -232,7 +232,7 @@ RenderResult RenderRun(const std::string& run_dir, const renders::RenderParams& 
       if (options.show_progress) progress.Update(k + 1);
     }
     video.Finish();
-    progress.Finish();
+    if (options.show_progress) progress.Finish();
     result.video_frames = num_frames;
     result.video_wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     result.video_fps = num_frames / std::max(result.video_wall_s, 1e-9);
