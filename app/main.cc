@@ -10,6 +10,7 @@
 #include <CLI/CLI.hpp>
 
 #include "app/evaluate.h"
+#include "app/render_run.h"
 #include "app/replay.h"
 #include "app/run.h"
 #include "app/run_config.h"
@@ -56,6 +57,11 @@ int main(int argc, char** argv) {
   run->add_option("--set", overrides, "Override any config key: --set laser.range_noise_std_m=0")
       ->type_name("KEY=VALUE");
   run->add_flag("--quiet", quiet, "No progress bar");
+  bool no_render = false;
+  run->add_flag("--no-render", no_render, "Do not render at the end, whatever render.enabled says");
+  bool no_evaluate = false;
+  run->add_flag("--no-evaluate", no_evaluate,
+                "Do not evaluate at the end (ground_truth_map.csv, metrics in summary.json)");
 
   // mjslam replay
   CLI::App* replay =
@@ -126,6 +132,24 @@ int main(int argc, char** argv) {
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
   divergence->add_option("--out", divergence_out, "Output CSV [RUN_DIR/divergence.csv]");
+  // mjslam render
+  CLI::App* render = cli.add_subcommand(
+      "render", "Render a run directory (final.png, video.mp4, plots, index.html) or a sweep directory");
+  std::string render_dir;
+  std::vector<std::string> render_overrides;
+  mjslam::renders::RenderParams render_params;
+  render->add_option("DIR", render_dir, "Run directory or sweep directory")->required();
+  render->add_option("--width", render_params.width, "Image and video width, pixels")->capture_default_str();
+  render->add_option("--height", render_params.height, "Image and video height, pixels")->capture_default_str();
+  render->add_option("--fps", render_params.fps, "Video frames per second")->capture_default_str();
+  render->add_option("--speedup", render_params.speedup, "Simulated seconds per video second")
+      ->capture_default_str();
+  render->add_option("--crf", render_params.crf, "H.264 quality, 0 (lossless) .. 51")->capture_default_str();
+  bool render_no_video = false;
+  bool render_no_plots = false;
+  render->add_flag("--no-video", render_no_video, "No video.mp4");
+  render->add_flag("--no-plots", render_no_plots, "No plots and no index.html");
+  render->add_flag("--quiet", quiet, "No progress bar");
 
   CLI11_PARSE(cli, argc, argv);
 
@@ -153,11 +177,40 @@ int main(int argc, char** argv) {
       const mjslam::app::RunResult result = mjslam::app::RunSimulation(config, options);
       std::fprintf(stderr, "%s: %s after %d steps (%.1f s simulated)\n", options.out_dir.c_str(),
                    result.status.c_str(), result.steps, result.sim_time_s);
+      if (result.status == "completed" && !no_evaluate) {
+        mjslam::app::EvaluateRunDirectory(options.out_dir, mjslam::app::EvaluateOptions{});
+      }
+      if (result.status == "completed" && config.render.enabled && !no_render) {
+        mjslam::app::RenderOptions render_options;
+        render_options.show_progress = !quiet;
+        render_options.stop_requested = &g_stop_requested;
+        const mjslam::app::RenderResult rendered =
+            mjslam::app::RenderRun(options.out_dir, config.render, render_options);
+        std::fprintf(stderr, "%s: rendered (%d video frames, %.0f frames/s)\n", options.out_dir.c_str(),
+                     rendered.video_frames, rendered.video_fps);
+      }
       return result.status == "completed" ? 0 : 130;
     }
     if (show_config->parsed()) {
       std::fputs(mjslam::config::ToYaml(mjslam::app::LoadRunConfig(config_path, overrides)).c_str(),
                  stdout);
+      return 0;
+    }
+    if (render->parsed()) {
+      if (mjslam::app::IsSweepDirectory(render_dir)) {
+        mjslam::app::RenderSweep(render_dir);
+        std::fprintf(stderr, "%s: sweep report written\n", render_dir.c_str());
+        return 0;
+      }
+      render_params.video = !render_no_video;
+      render_params.plots = !render_no_plots;
+      mjslam::app::RenderOptions render_options;
+      render_options.show_progress = !quiet;
+      render_options.stop_requested = &g_stop_requested;
+      const mjslam::app::RenderResult rendered =
+          mjslam::app::RenderRun(render_dir, render_params, render_options);
+      std::fprintf(stderr, "%s: rendered (%d video frames in %.2f s: %.1f frames/s)\n", render_dir.c_str(),
+                   rendered.video_frames, rendered.video_wall_s, rendered.video_fps);
       return 0;
     }
     if (replay->parsed()) {
@@ -230,6 +283,8 @@ int main(int argc, char** argv) {
     }
   } catch (const std::exception& error) {
     std::fprintf(stderr, "mjslam: error:\n%s\n", error.what());
+    // A render stopped by Ctrl-C or SIGTERM is an interrupt, not a failure.
+    if (g_stop_requested != 0) return 130;
     return 1;
   }
   return 0;

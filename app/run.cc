@@ -145,8 +145,6 @@ RunResult RunSimulation(const RunConfig& config, const RunOptions& options) {
     bool in_contact = false;
     double t90 = -1.0;
     double t99 = -1.0;
-    double processing_s[2] = {0.0, 0.0};
-    double open_loop_s[2] = {0.0, 0.0};
     Pose2 X_WR_previous = X_WR0;
     result.status = "completed";
 
@@ -189,10 +187,6 @@ RunResult RunSimulation(const RunConfig& config, const RunOptions& options) {
 
       // Both filters on the same record.
       slam.Step(record);
-      for (int f = 0; f < 2; ++f) {
-        processing_s[f] += slam.processing_s(f);
-        open_loop_s[f] += (slam.period_steps(f) - 1) * dt;
-      }
 
       // The controller issues a command when the last period has run out;
       // the command is then held for the period the driving filter's
@@ -276,8 +270,8 @@ RunResult RunSimulation(const RunConfig& config, const RunOptions& options) {
             {"y", X_WR_estimate.y - X_WR_end.y},
             {"th", WrapAngle(X_WR_estimate.theta - X_WR_end.theta)}}},
           {"num_features", slam.filter(f).num_features()},
-          {"processing_s", processing_s[f]},
-          {"open_loop_s", open_loop_s[f]}};
+          {"processing_s", slam.total_processing_s(f)},
+          {"open_loop_s", slam.open_loop_s(f)}};
     }
   } catch (const std::exception& error) {
     manifest["status"] = "failed";

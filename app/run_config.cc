@@ -27,6 +27,7 @@ std::vector<ParamProblem> RunConfig::Validate() const {
   check.Merge("slam", slam.Validate());
   check.Merge("control", control.Validate());
   check.Merge("explorer", explorer.Validate());
+  check.Merge("render", render.Validate());
   // The laser fires on control steps only.
   if (run.control_rate_hz > 0 && laser.rate_hz > 0) {
     const double ratio = run.control_rate_hz / laser.rate_hz;

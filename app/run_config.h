@@ -8,6 +8,7 @@
 #include "common/params.h"
 #include "explorer/explorer_params.h"
 #include "explorer/waypoint_driver.h"
+#include "renders/render_params.h"
 #include "sim/sim_params.h"
 #include "slam/slam_params.h"
 
@@ -51,6 +52,8 @@ struct RunConfig {
   slam::SlamParams slam;
   ControlParams control;
   explorer::ExplorerParams explorer;
+  /// Renders at the end of a completed `mjslam run` (renders/).
+  renders::RenderParams render;
 
   template <typename Archive>
   void Serialize(Archive* a) {
@@ -63,6 +66,7 @@ struct RunConfig {
     a->Visit(MJSLAM_NVP(slam));
     a->Visit(MJSLAM_NVP(control));
     a->Visit(MJSLAM_NVP(explorer));
+    a->Visit(MJSLAM_NVP(render));
   }
   std::vector<ParamProblem> Validate() const;
   void ValidateOrThrow() const { ThrowIfProblems(Validate()); }

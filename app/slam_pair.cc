@@ -42,6 +42,12 @@ void SlamPair::Step(const SensorRecord& record) {
     f.processing_us = extraction_us + MicrosecondsSince(start);
     f.processing_s = ProcessingSeconds(control_, f.report, record.has_scan, f.processing_us);
     f.period_steps = CommandPeriodSteps(f.processing_s, dt_s_);
+    f.total_processing_s += f.processing_s;
+    if (f.steps_to_next_command <= 0) {
+      f.open_loop_s += (f.period_steps - 1) * dt_s_;
+      f.steps_to_next_command = f.period_steps;
+    }
+    --f.steps_to_next_command;
   }
 }
 
@@ -49,7 +55,8 @@ std::vector<std::string> SlamPair::Columns() {
   std::vector<std::string> columns;
   for (const char* prefix : {"classical", "selective"}) {
     for (const char* name : {"x", "y", "th", "pxx", "pxy", "pxth", "pyy", "pyth", "pthth",
-                             "nfeat", "nmatched", "nupdated", "us", "period", "nees"}) {
+                             "nfeat", "nmatched", "nupdated", "us", "period", "open_loop",
+                             "nees"}) {
       columns.push_back(std::string(prefix) + "_" + name);
     }
   }
@@ -74,6 +81,7 @@ void SlamPair::AddColumns(const Pose2& X_WR_true, CsvWriter* writer) const {
     writer->Add(f.report.num_updated);
     writer->Add(f.processing_us);
     writer->Add(f.period_steps * dt_s_);
+    writer->Add(f.open_loop_s);
     // Empty where P is (nearly) singular: the known start and the steps after.
     const double nees = eval::EvaluatePoseStep(X_WR_true, X_WR, P).nees;
     if (std::isfinite(nees)) {

@@ -28,7 +28,7 @@ class SlamPair {
 
   /// The per-filter columns of trajectory.csv, for prefixes "classical" and
   /// "selective": f_x,f_y,f_th,f_pxx,f_pxy,f_pxth,f_pyy,f_pyth,f_pthth,
-  /// f_nfeat,f_nmatched,f_nupdated,f_us,f_period,f_nees.
+  /// f_nfeat,f_nmatched,f_nupdated,f_us,f_period,f_open_loop,f_nees.
   static std::vector<std::string> Columns();
   /// Appends the values of Columns() for the last step; X_WR_true is the true
   /// pose of R for the NEES.
@@ -39,6 +39,12 @@ class SlamPair {
   /// imposes, in control steps.
   double processing_s(int i) const { return filters_[i].processing_s; }
   int period_steps(int i) const { return filters_[i].period_steps; }
+  /// Totals so far of filter `i`: processing time, and open-loop time on its
+  /// own command timeline (a command is issued when the last one's period
+  /// has run out and held for the period of that step; all of it but one
+  /// control step runs open loop), seconds.
+  double total_processing_s(int i) const { return filters_[i].total_processing_s; }
+  double open_loop_s(int i) const { return filters_[i].open_loop_s; }
   /// Filter `i` by index, and its name.
   const slam::EkfSlam& filter(int i) const { return filters_[i].filter; }
   const std::string& name(int i) const { return filters_[i].name; }
@@ -57,6 +63,9 @@ class SlamPair {
     double processing_us = 0.0;
     double processing_s = 0.0;
     int period_steps = 1;
+    double total_processing_s = 0.0;
+    double open_loop_s = 0.0;
+    int steps_to_next_command = 0;
   };
   slam::SlamParams params_;
   ControlParams control_;

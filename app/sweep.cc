@@ -152,7 +152,8 @@ SweepResult RunSweep(const RunConfig& config, const SweepOptions& options) {
   auto start = [&](Job* job) {
     const std::uint64_t seed = config.run.seed + static_cast<std::uint64_t>(job->index);
     if (job->stage == 0) {
-      job->pid = Spawn({options.program, "run", "--quiet", "--config", config_path, "--seed",
+      job->pid = Spawn({options.program, "run", "--quiet", "--no-render", "--no-evaluate",
+                        "--config", config_path, "--seed",
                         std::to_string(seed), "--out", job->dir},
                        job->dir + ".log");
     } else {
@@ -241,23 +242,20 @@ nlohmann::json AggregateSweep(const std::vector<std::string>& run_dirs, const st
     std::vector<double> run_times;
     for (const std::vector<double>& row : table.rows) run_times.push_back(row[t]);
     times.push_back(run_times);
-    const double dt = run_times.size() > 1 ? run_times[1] - run_times[0] : 0.0;
     for (std::size_t f = 0; f < names.size(); ++f) {
       nees[f].push_back(PoseNees(table, names[f]));
       const int us = table.ColumnIndex(names[f] + "_us");
       double total_us = 0.0;
       for (const std::vector<double>& row : table.rows) total_us += row[us];
       processing_s[f].push_back(total_us * 1e-6);
-      // Open loop: the time each step holds its command beyond one period.
+      // Open loop: the run's accumulated f_open_loop at its last step.
       for (std::size_t c = 0; c < table.columns.size(); ++c) {
-        if (table.columns[c] != names[f] + "_period") continue;
-        double open = 0.0;
-        double longest = 0.0;
-        for (const std::vector<double>& row : table.rows) {
-          open += std::max(0.0, row[c] - dt);
-          longest = std::max(longest, row[c]);
+        if (table.columns[c] == names[f] + "_open_loop" && !table.rows.empty()) {
+          open_loop_s[f].push_back(table.rows.back()[c]);
         }
-        open_loop_s[f].push_back(open);
+        if (table.columns[c] != names[f] + "_period") continue;
+        double longest = 0.0;
+        for (const std::vector<double>& row : table.rows) longest = std::max(longest, row[c]);
         max_period_s[f].push_back(longest);
       }
     }

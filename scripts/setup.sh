@@ -15,6 +15,10 @@ packages=(
   nlohmann-json3-dev   # nlohmann-json: manifests and summaries
   libgtest-dev         # GoogleTest: the test suite
   libbenchmark-dev     # Google Benchmark: bench/
+  libpng-dev           # libpng: final.png of the renders
+  ffmpeg               # ffmpeg/ffprobe: video.mp4 of the renders (H.264), its test
+  python3-matplotlib   # matplotlib: the plots of runs and sweeps (renders/report.py)
+  chromium             # headless Chromium: the test that index.html loads
 )
 
 missing=()

@@ -19,7 +19,7 @@ using app::ReadCsv;
 
 // A short run of the default config into `dir`.
 int ShortRun(const std::string& dir, int seed, const std::string& extra = "") {
-  return Shell(Program() + " run --quiet --config " + DefaultConfig() + " --duration 12 --seed " +
+  return Shell(Program() + " run --quiet --no-render --config " + DefaultConfig() + " --duration 12 --seed " +
                std::to_string(seed) + " --out " + dir + " " + extra + " 2> " + dir + ".log");
 }
 
@@ -138,7 +138,7 @@ TEST(RunFailureTest, InterruptedRunKeepsCompleteRowsAndSaysSo) {
   if (child == 0) {
     const std::string program = Program();
     const std::string config = DefaultConfig();
-    execl(program.c_str(), program.c_str(), "run", "--quiet", "--config", config.c_str(),
+    execl(program.c_str(), program.c_str(), "run", "--quiet", "--no-render", "--config", config.c_str(),
           "--duration", "100000", "--out", dir.c_str(), static_cast<char*>(nullptr));
     _exit(127);
   }
@@ -165,7 +165,7 @@ TEST(RunFailureTest, InterruptedRunKeepsCompleteRowsAndSaysSo) {
 
 TEST(RunFailureTest, MissingWorldIsAClearErrorAndNoRunIsStarted) {
   const std::string dir = FreshDir("missing_world");
-  const int status = Shell(Program() + " run --quiet --config " + DefaultConfig() +
+  const int status = Shell(Program() + " run --quiet --no-render --config " + DefaultConfig() +
                            " --world /no/such/world.xml --out " + dir + "/run 2> " + dir +
                            "/err.log");
   EXPECT_EQ(status, 1);
@@ -175,7 +175,7 @@ TEST(RunFailureTest, MissingWorldIsAClearErrorAndNoRunIsStarted) {
 
 TEST(RunFailureTest, BadOverrideNamesTheKeyAndValue) {
   const std::string dir = FreshDir("bad_override");
-  const int status = Shell(Program() + " run --quiet --config " + DefaultConfig() +
+  const int status = Shell(Program() + " run --quiet --no-render --config " + DefaultConfig() +
                            " --set laser.max_range_m=-4 --out " + dir + "/run 2> " + dir +
                            "/err.log");
   EXPECT_EQ(status, 1);

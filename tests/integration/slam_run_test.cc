@@ -20,7 +20,7 @@ class SlamRunTest : public ::testing::Test {
   static void SetUpTestSuite() {
     for (const int seed : {1, 2, 3}) {
       const std::string dir = FreshDir("slam_run_" + std::to_string(seed));
-      ASSERT_EQ(Shell(Program() + " run --quiet --config " + DefaultConfig() +
+      ASSERT_EQ(Shell(Program() + " run --quiet --no-render --config " + DefaultConfig() +
                       " --set control.driver=tour --duration 60 --seed " + std::to_string(seed) +
                       " --out " + dir + " 2> " +
                       dir + ".log"),

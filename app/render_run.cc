@@ -1,0 +1,255 @@
+#include "app/render_run.h"
+
+#include <sys/wait.h>
+
+#include <spawn.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <map>
+#include <stdexcept>
+#include <vector>
+
+#include "app/csv_reader.h"
+#include "app/progress.h"
+#include "app/run_config.h"
+#include "renders/scene_renderer.h"
+#include "renders/video_writer.h"
+
+extern char** environ;
+
+namespace mjslam::app {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// One filter's columns of trajectory.csv.
+struct FilterColumns {
+  std::string name;
+  renders::Rgb color;
+  int x, y, th, pxx, pxy, pyy;
+};
+
+// The explorer's sets over time: rows grouped by their time.
+struct ExplorerSnapshot {
+  double t_s;
+  renders::ExplorerLayer layer;
+};
+
+std::vector<ExplorerSnapshot> ReadExplorer(const std::string& path) {
+  std::vector<ExplorerSnapshot> snapshots;
+  if (!fs::exists(path)) return snapshots;
+  const CsvTable table = ReadCsv(path, {"kind"});
+  const int t = table.ColumnIndex("t");
+  table.ColumnIndex("kind");  // the only text column: text[r][0]
+  const int index = table.ColumnIndex("index"), x = table.ColumnIndex("x"), y = table.ColumnIndex("y");
+  std::vector<std::pair<double, Eigen::Vector2d>> path_points;
+  auto close = [&]() {
+    if (snapshots.empty()) return;
+    std::stable_sort(path_points.begin(), path_points.end(),
+                     [](const auto& a, const auto& b) { return a.first < b.first; });
+    for (const auto& [i, p] : path_points) snapshots.back().layer.path.push_back(p);
+    path_points.clear();
+  };
+  for (std::size_t r = 0; r < table.rows.size(); ++r) {
+    const std::vector<double>& row = table.rows[r];
+    if (snapshots.empty() || row[t] != snapshots.back().t_s) {
+      close();
+      snapshots.push_back({row[t], {}});
+    }
+    const std::string& k = table.text[r][0];
+    const Eigen::Vector2d p(row[x], row[y]);
+    if (k == "frontier") {
+      snapshots.back().layer.frontier.push_back(p);
+    } else if (k == "goal") {
+      snapshots.back().layer.goal = p;
+    } else if (k == "path") {
+      path_points.emplace_back(row[index], p);
+    } else {
+      throw std::runtime_error(path + ":" + std::to_string(r + 2) +
+                               ": kind: expected frontier, goal or path (got '" + k + "')");
+    }
+  }
+  close();
+  return snapshots;
+}
+
+void ReadMap(const std::string& path, renders::FilterLayer* layer) {
+  if (!fs::exists(path)) return;
+  const CsvTable table = ReadCsv(path, {"type"});
+  table.ColumnIndex("type");  // the only text column: text[r][0]
+  const int p0 = table.ColumnIndex("p0"), p1 = table.ColumnIndex("p1");
+  const int ax = table.ColumnIndex("ax"), ay = table.ColumnIndex("ay");
+  const int bx = table.ColumnIndex("bx"), by = table.ColumnIndex("by");
+  for (std::size_t r = 0; r < table.rows.size(); ++r) {
+    const std::vector<double>& row = table.rows[r];
+    if (table.text[r][0] == "corner") {
+      layer->corners.emplace_back(row[p0], row[p1]);
+    } else if (std::isfinite(row[ax]) && std::isfinite(row[bx])) {
+      layer->lines.push_back({{row[ax], row[ay]}, {row[bx], row[by]}});
+    }
+  }
+}
+
+constexpr char kPython[] = "/usr/bin/python3";
+
+// Runs renders/report.py with `arguments`; throws when it fails.
+void RunReportScript(const std::vector<std::string>& arguments) {
+  // Debian's interpreter, which finds Debian's matplotlib (a python3 earlier
+  // on PATH, e.g. from pyenv, may not).
+  std::vector<std::string> all = {kPython, std::string(MJSLAM_SOURCE_DIR) + "/renders/report.py"};
+  all.insert(all.end(), arguments.begin(), arguments.end());
+  std::vector<char*> argv;
+  for (std::string& a : all) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  pid_t pid = -1;
+  const int spawned = ::posix_spawn(&pid, kPython, nullptr, nullptr, argv.data(), environ);
+  if (spawned != 0) {
+    throw std::runtime_error(std::string("cannot start ") + kPython + " for the plots: " + std::strerror(spawned));
+  }
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
+    throw std::runtime_error("renders/report.py failed for '" + arguments.back() + "'");
+  }
+}
+
+}  // namespace
+
+bool IsSweepDirectory(const std::string& dir) {
+  return fs::is_directory(fs::path(dir) / "runs") && !fs::exists(fs::path(dir) / "trajectory.csv");
+}
+
+void RenderSweep(const std::string& sweep_dir) { RunReportScript({"sweep", sweep_dir}); }
+
+RenderResult RenderRun(const std::string& run_dir, const renders::RenderParams& params,
+                       const RenderOptions& options) {
+  params.ValidateOrThrow();
+  const fs::path dir(run_dir);
+  if (!fs::is_directory(dir)) throw std::runtime_error("run directory not found: '" + run_dir + "'");
+  const RunConfig config = LoadRunConfig((dir / "config.yaml").string(), {});
+
+  // The run's files.
+  const CsvTable trajectory = ReadCsv((dir / "trajectory.csv").string());
+  if (trajectory.rows.empty()) {
+    throw std::runtime_error((dir / "trajectory.csv").string() + ": no rows to render");
+  }
+  const CsvTable scans = ReadCsv((dir / "scans.csv").string());
+  const std::vector<ExplorerSnapshot> explorer = ReadExplorer((dir / "explorer.csv").string());
+  const int t_col = trajectory.ColumnIndex("t");
+  const int true_x = trajectory.ColumnIndex("true_x"), true_y = trajectory.ColumnIndex("true_y");
+  const int true_th = trajectory.ColumnIndex("true_th");
+  std::vector<FilterColumns> filters;
+  for (const auto& [name, color] : {std::pair<std::string, renders::Rgb>{"classical", renders::colors::kClassical},
+                                    std::pair<std::string, renders::Rgb>{"selective", renders::colors::kSelective}}) {
+    filters.push_back({name, color, trajectory.ColumnIndex(name + "_x"), trajectory.ColumnIndex(name + "_y"),
+                       trajectory.ColumnIndex(name + "_th"), trajectory.ColumnIndex(name + "_pxx"),
+                       trajectory.ColumnIndex(name + "_pxy"), trajectory.ColumnIndex(name + "_pyy")});
+  }
+  const int scan_t = scans.ColumnIndex("t"), scan_x = scans.ColumnIndex("x");
+  const int scan_y = scans.ColumnIndex("y"), scan_th = scans.ColumnIndex("th");
+  const int scan_r0 = scans.ColumnIndex("r0");
+  const int num_beams = static_cast<int>(scans.columns.size()) - scan_r0;
+
+  renders::SceneRenderer renderer(config.run.world, config.run.robot_model, config.sim, config.robot,
+                                  params.width, params.height);
+  // Paths keep a point once it is a pixel away from the last one kept.
+  const double pixel_m = std::abs(renderer.PixelOf({0.0, 0.0}).x() - renderer.PixelOf({1.0, 0.0}).x());
+  const double min_step_m = 1.0 / std::max(pixel_m, 1e-9);
+
+  renders::SceneFrame frame;
+  frame.ellipse_scale = params.ellipse_scale;
+  for (const FilterColumns& f : filters) {
+    renders::FilterLayer layer;
+    layer.name = f.name;
+    layer.color = f.color;
+    frame.filters.push_back(layer);
+  }
+  std::size_t next_row = 0;
+  auto append = [&](std::vector<Eigen::Vector2d>* path, const Eigen::Vector2d& p, bool last) {
+    if (path->empty() || (p - path->back()).norm() >= min_step_m || last) path->push_back(p);
+  };
+  // Advances the frame to time T: paths, poses, current scan and explorer sets.
+  auto advance_to = [&](double T) {
+    while (next_row < trajectory.rows.size() && trajectory.rows[next_row][t_col] <= T + 1e-9) {
+      const std::vector<double>& row = trajectory.rows[next_row];
+      const bool last = next_row + 1 == trajectory.rows.size();
+      frame.t_s = row[t_col];
+      frame.X_WR_true = Pose2(row[true_x], row[true_y], row[true_th]);
+      append(&frame.true_path, {row[true_x], row[true_y]}, last);
+      for (std::size_t i = 0; i < filters.size(); ++i) {
+        const FilterColumns& f = filters[i];
+        renders::FilterLayer& layer = frame.filters[i];
+        append(&layer.path, {row[f.x], row[f.y]}, last);
+        layer.X_WR = Pose2(row[f.x], row[f.y], row[f.th]);
+        layer.P_xy << row[f.pxx], row[f.pxy], row[f.pxy], row[f.pyy];
+      }
+      ++next_row;
+    }
+    frame.laser_hits.clear();
+    const auto scan = std::upper_bound(scans.rows.begin(), scans.rows.end(), T + 1e-9,
+                                       [&](double value, const std::vector<double>& row) { return value < row[scan_t]; });
+    if (scan != scans.rows.begin()) {
+      const std::vector<double>& row = *(scan - 1);
+      const Pose2 X_WS(row[scan_x], row[scan_y], row[scan_th]);
+      for (int i = 0; i < num_beams; ++i) {
+        const double range = row[scan_r0 + i];
+        if (!(range < config.laser.max_range_m)) continue;
+        const double bearing = config.laser.AngleMinRad() + i * config.laser.AngleIncrementRad();
+        frame.laser_hits.push_back(X_WS * Eigen::Vector2d(range * std::cos(bearing), range * std::sin(bearing)));
+      }
+    }
+    frame.explorer.reset();
+    const auto snapshot = std::upper_bound(explorer.begin(), explorer.end(), T + 1e-9,
+                                           [](double value, const ExplorerSnapshot& s) { return value < s.t_s; });
+    if (snapshot != explorer.begin()) frame.explorer = (snapshot - 1)->layer;
+  };
+  auto stopped = [&]() { return options.stop_requested != nullptr && *options.stop_requested != 0; };
+
+  RenderResult result;
+  const double end_t = trajectory.rows.back()[t_col];
+  if (params.video) {
+    const auto start = std::chrono::steady_clock::now();
+    const double frame_dt = params.speedup / params.fps;
+    const int num_frames = static_cast<int>(std::floor(end_t / frame_dt + 1e-9)) + 1;
+    renders::VideoWriter video((dir / "video.mp4").string(), params.width, params.height, params.fps, params.crf);
+    Progress progress("render", num_frames);
+    for (int k = 0; k < num_frames; ++k) {
+      if (stopped()) throw std::runtime_error("render of '" + run_dir + "' interrupted; no video written");
+      const bool last = k + 1 == num_frames;
+      advance_to(last ? end_t : k * frame_dt);
+      if (last) {
+        for (std::size_t i = 0; i < filters.size(); ++i) {
+          ReadMap((dir / ("map_" + filters[i].name + ".csv")).string(), &frame.filters[i]);
+        }
+      }
+      video.AddFrame(renderer.Render(frame));
+      if (options.show_progress) progress.Update(k + 1);
+    }
+    video.Finish();
+    if (options.show_progress) progress.Finish();
+    result.video_frames = num_frames;
+    result.video_wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    result.video_fps = num_frames / std::max(result.video_wall_s, 1e-9);
+  }
+
+  // The final image: the whole run with both final maps.
+  advance_to(end_t);
+  for (std::size_t i = 0; i < filters.size(); ++i) {
+    renders::FilterLayer& layer = frame.filters[i];
+    layer.lines.clear();
+    layer.corners.clear();
+    ReadMap((dir / ("map_" + filters[i].name + ".csv")).string(), &layer);
+  }
+  renders::WritePng((dir / "final.png").string(), renderer.Render(frame));
+
+  if (params.plots) RunReportScript({"run", dir.string()});
+  return result;
+}
+
+}  // namespace mjslam::app
