@@ -1,0 +1,75 @@
+#!/usr/bin/python3
+"""Explores every shipped world with the default config, 5 seeds each, and
+prints the table of issue 4 (README, "Exploring the shipped worlds").
+
+    scripts/explore_worlds.py [--out DIR] [--runs N] [--jobs J] [--worlds W ...]
+
+Runs `build/mjslam sweep` once per world (seeds run.seed + 0 .. N-1, into
+DIR/<world>/runs/), then reads each run's summary.json. A world passes when
+every run has no collision, has seen at least 95 % of the reachable free area,
+and keeps both filters' pose errors inside 2 sigma for at least 90 % of the
+steps per component. Exit status 0 when every world passes, 1 otherwise.
+"""
+import argparse
+import json
+import os
+import subprocess
+import sys
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+WORLDS = ["room", "corridor_loop", "office", "pillars"]
+FILTERS = ["classical", "selective"]
+
+
+def sweep(world, out, runs, jobs):
+    command = [os.path.join(ROOT, "build", "mjslam"), "sweep",
+               "--config", os.path.join(ROOT, "configs", "default.yaml"),
+               "--runs", str(runs), "--jobs", str(jobs), "--out", out, "--quiet",
+               "--divergence-points", "0",
+               "--set", "run.world=" + os.path.join(ROOT, "worlds", world + ".xml")]
+    subprocess.run(command, check=True)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--out", default=os.path.join(ROOT, "runs", "explore_worlds"))
+    parser.add_argument("--runs", type=int, default=5)
+    parser.add_argument("--jobs", type=int, default=2)
+    parser.add_argument("--worlds", nargs="+", default=WORLDS)
+    args = parser.parse_args()
+
+    header = ("| world | runs | collisions | explored (min) | end | time (mean) "
+              "| classical x, y, th inside 2 sigma (min) | selective x, y, th inside 2 sigma (min) | pass |")
+    lines = [header, "|" + "---|" * 9]
+    all_pass = True
+    for world in args.worlds:
+        out = os.path.join(args.out, world)
+        sweep(world, out, args.runs, args.jobs)
+        runs_dir = os.path.join(out, "runs")
+        summaries = []
+        for name in sorted(os.listdir(runs_dir)):
+            path = os.path.join(runs_dir, name, "summary.json")
+            if os.path.isfile(path):
+                with open(path) as f:
+                    summaries.append(json.load(f))
+        collisions = sum(s["run"]["collisions"] for s in summaries)
+        explored = min(s["run"]["explored_fraction"] for s in summaries)
+        ends = sorted({s["run"]["termination_reason"] for s in summaries})
+        duration = sum(s["run"]["duration_s"] for s in summaries) / len(summaries)
+        inside = {f: [min(s["filters"][f]["inside_2sigma"][c] for s in summaries)
+                      for c in ("x", "y", "th")] for f in FILTERS}
+        ok = (len(summaries) == args.runs and collisions == 0 and explored >= 0.95 and
+              all(v >= 0.90 for f in FILTERS for v in inside[f]))
+        all_pass = all_pass and ok
+        cells = [f"`{world}`", str(len(summaries)), str(collisions), f"{100 * explored:.1f} %",
+                 ", ".join(ends), f"{duration:.0f} s"]
+        cells += [", ".join(f"{v:.2f}" for v in inside[f]) for f in FILTERS]
+        cells.append("yes" if ok else "**no**")
+        lines.append("| " + " | ".join(cells) + " |")
+        print(lines[-1], file=sys.stderr)
+    print("\n".join(lines))
+    return 0 if all_pass else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
