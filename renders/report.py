@@ -179,7 +179,7 @@ def plot_divergence(div, path):
         ax.set_ylabel(f"divergence {key} (nats)" if key == "mean" else "divergence variance (nats²)")
         ax.grid(True, alpha=0.3, which="both")
     axes[0].legend(fontsize=8)
-    fig.suptitle("KL divergence between the filters' pose distributions")
+    fig.suptitle("Map divergence (KL) between the filters' maps and to the ground truth")
     fig.tight_layout()
     save(fig, path)
 
