@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <limits>
 
 #include "common/angles.h"
@@ -46,6 +47,9 @@ constexpr double kPathCheckRangeM = 3.0;
 constexpr double kRecoveryAfterS = 1.0;
 constexpr double kRecoveryS = 1.5;
 constexpr double kRecoverySpeedMps = 0.1;
+// In-place turn rate of a recovery that can neither back up nor drive
+// forward, rad/s.
+constexpr double kRecoveryTurnRadps = 0.4;
 
 }  // namespace
 
@@ -317,16 +321,36 @@ ExplorerOutput Explorer::Step(const Pose2& X_WR, const LaserScan* scan, const Po
   }
   if (recovery_until_s_ >= t_s) {
     // Recovery: back up straight while it is safe (the occupied cells of the
-    // grid cover the space behind the laser).
-    const Twist2 back{-kRecoverySpeedMps, 0.0};
-    bool back_limited = false;
-    const Twist2 safe_back = SafetyFilter(back, X_WR, obstacles, params_, a_m_, dt_s,
-                                          &back_limited);
-    if (!back_limited) {
-      command = safe_back;
-    } else {
-      recovery_until_s_ = -1.0;
+    // grid cover the space behind the laser); when it is not, drive forward
+    // straight, then turn in place either way, so that a robot wedged next
+    // to a door jamb (where neither backing up nor the turn the path wants
+    // is safe) gets free instead of failing every goal in turn. The motion
+    // chosen at the start of a recovery is kept while it stays safe.
+    const Twist2 escapes[] = {{-kRecoverySpeedMps, 0.0},
+                              {kRecoverySpeedMps, 0.0},
+                              {0.0, kRecoveryTurnRadps},
+                              {0.0, -kRecoveryTurnRadps}};
+    bool found = false;
+    const int n = static_cast<int>(std::size(escapes));
+    for (int k = 0; k < n && !found; ++k) {
+      // The current escape first, then the others in order.
+      const int i = recovery_escape_ >= 0 ? (recovery_escape_ + k) % n : k;
+      if (recovery_escape_ >= 0 && k > 0) break;
+      bool escape_limited = false;
+      const Twist2 safe = SafetyFilter(escapes[i], X_WR, obstacles, params_, a_m_, dt_s,
+                                       &escape_limited);
+      if (!escape_limited) {
+        command = safe;
+        recovery_escape_ = i;
+        found = true;
+      }
     }
+    if (!found) {
+      recovery_until_s_ = -1.0;
+      recovery_escape_ = -1;
+    }
+  } else {
+    recovery_escape_ = -1;
   }
   command = SafetyFilter(command, X_WR, obstacles, params_, a_m_, dt_s, &limited);
   tracker_.set_last_command(command);

@@ -138,6 +138,8 @@ class Explorer {
   double blocked_total_s_ = 0.0;
   // End of the current back-up recovery, seconds (< t when none).
   double recovery_until_s_ = -1.0;
+  // Index of the escape motion of the current recovery, or -1.
+  int recovery_escape_ = -1;
 
   double turned_rad_ = 0.0;
   double last_theta_ = 0.0;

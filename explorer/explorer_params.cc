@@ -18,6 +18,8 @@ std::vector<ParamProblem> ExplorerParams::Validate() const {
   check.Require(body_front_x_m > body_rear_x_m, "body_front_x_m", body_front_x_m,
                 "a value > body_rear_x_m");
   check.Positive("body_half_width_m", body_half_width_m);
+  check.NonNegative("wheel_y_m", wheel_y_m);
+  check.NonNegative("wheel_radius_m", wheel_radius_m);
   check.Require(clearance_m >= body_half_width_m, "clearance_m", clearance_m,
                 "a value >= body_half_width_m");
   check.Require(preferred_clearance_m >= clearance_m, "preferred_clearance_m",

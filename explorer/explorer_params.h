@@ -37,6 +37,13 @@ struct ExplorerParams {
   double body_rear_x_m = -0.47;
   /// Half the body width.
   double body_half_width_m = 0.19;
+  /// The drive wheels' collision discs (MuJoCo spheres of the wheel radius,
+  /// which reach past the body's sides): centre x in R (the axle, a behind
+  /// h), centre |y|, radius. They are part of the footprint the safety layer
+  /// checks. A radius of 0 leaves them out.
+  double wheel_x_m = -0.2025;
+  double wheel_y_m = 0.165;
+  double wheel_radius_m = 0.0975;
 
   // --- Planning ---
   /// Smallest distance between a planned path of h and an occupied cell,
@@ -135,6 +142,9 @@ struct ExplorerParams {
     a->Visit(MJSLAM_NVP(body_front_x_m));
     a->Visit(MJSLAM_NVP(body_rear_x_m));
     a->Visit(MJSLAM_NVP(body_half_width_m));
+    a->Visit(MJSLAM_NVP(wheel_x_m));
+    a->Visit(MJSLAM_NVP(wheel_y_m));
+    a->Visit(MJSLAM_NVP(wheel_radius_m));
     a->Visit(MJSLAM_NVP(clearance_m));
     a->Visit(MJSLAM_NVP(preferred_clearance_m));
     a->Visit(MJSLAM_NVP(clearance_cost_weight));

@@ -19,6 +19,10 @@ constexpr double kTurnPointToleranceM = 0.1;
 constexpr double kTurnDoneRad = 0.1;
 // How far ahead of the last nearest point h's nearest point is searched, m.
 constexpr double kSearchWindowM = 1.5;
+// The wheels reach a new command with a lag (MuJoCo's torque-driven wheels:
+// about 0.03 s in the office runs); the safety layer predicts each command held
+// this much longer than the control period, seconds.
+constexpr double kWheelLagS = 0.05;
 
 }  // namespace
 
@@ -117,11 +121,18 @@ Twist2 PathTracker::Command(const Pose2& X_WR, double dt_s) {
 bool BodyTouches(const Pose2& X_WR, const std::vector<Eigen::Vector2d>& points_W,
                  const ExplorerParams& params, double margin_m) {
   const Pose2 X_RW = X_WR.Inverse();
+  const bool wheels = params.wheel_radius_m > 0.0;
+  const double wheel_reach = params.wheel_radius_m + margin_m;
   for (const Eigen::Vector2d& p_W : points_W) {
     const Eigen::Vector2d p_R = X_RW * p_W;
     if (p_R.x() >= params.body_rear_x_m - margin_m &&
         p_R.x() <= params.body_front_x_m + margin_m &&
         std::abs(p_R.y()) <= params.body_half_width_m + margin_m) {
+      return true;
+    }
+    // The wheels' collision discs reach past the body's sides.
+    if (wheels && Eigen::Vector2d(p_R.x() - params.wheel_x_m, std::abs(p_R.y()) - params.wheel_y_m)
+                          .squaredNorm() <= wheel_reach * wheel_reach) {
       return true;
     }
   }
@@ -143,8 +154,11 @@ bool PredictedContact(const Twist2& command, const Pose2& X_WR,
     if ((q - X_WR.translation()).squaredNorm() < reach * reach) near.push_back(q);
   }
   if (near.empty()) return false;
+  // The wheels follow a new command with a lag: the command acts for about
+  // kWheelLagS longer than it is held before the brake takes effect.
+  const double hold = dt_s + kWheelLagS;
   const double brake_time = std::abs(command.v_mps) / params.brake_decel_mps2;
-  const double horizon = dt_s + brake_time;
+  const double horizon = hold + brake_time;
   const double step = 0.05;
   const int n = std::max(1, static_cast<int>(std::ceil(horizon / step)));
   // Pose of the axle A (a behind h).
@@ -155,7 +169,7 @@ bool PredictedContact(const Twist2& command, const Pose2& X_WR,
     if (BodyTouches(X_WA * X_AR, near, params, margin_m)) return true;
     // Speed scale: 1 while held, then linear braking.
     const double scale =
-        t < dt_s ? 1.0 : std::max(0.0, 1.0 - (t - dt_s) / std::max(brake_time, 1e-9));
+        t < hold ? 1.0 : std::max(0.0, 1.0 - (t - hold) / std::max(brake_time, 1e-9));
     const double h = horizon / n;
     const double v = scale * command.v_mps;
     const double w = scale * command.w_radps;

@@ -93,6 +93,21 @@ TEST(ExplorerClosedLoopTest, ExploresTwoRoomsWithoutContact) {
 // paths keep 0.5 m clearance): the explorer explores its own room, does not
 // circle in front of the door, and ends with `unreachable` well before the
 // time limit.
+TEST(ExplorerClosedLoopTest, GetsFreeWhenWedgedNextToTheDoorWall) {
+  // Just through the door, heading -54 deg, the rear right corner 8 cm from
+  // the door wall below the jamb (office, seed 3: wedged in a doorway). The
+  // initial turn (to the left) and backing up would both touch the wall;
+  // only driving forward is safe. The recovery must find it, instead of
+  // holding the robot still for good.
+  const EpisodeResult result = RunEpisode(Pose2(5.51, 1.93, DegToRad(-54.0)), 300.0);
+  std::printf("wedged start: %s after %.1f s, %.1f %% seen, %d contacts\n",
+              result.reason.c_str(), result.t_s, 100.0 * result.explored, result.contacts);
+  EXPECT_TRUE(result.finished);
+  EXPECT_EQ(result.reason, "no_frontier");
+  EXPECT_GE(result.explored, 0.95);
+  EXPECT_EQ(result.contacts, 0);
+}
+
 TEST(ExplorerClosedLoopTest, EndsUnreachableBehindANarrowDoor) {
   const EpisodeResult result = RunEpisode(Pose2(1.5, 1.0, 0.3), 600.0, 0.7);
   std::printf("narrow door: finished %d (%s) at t = %.1f s, explored %.3f, contacts %d\n",

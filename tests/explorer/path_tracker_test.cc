@@ -84,8 +84,12 @@ TEST(SafetyFilterTest, StopsBeforeAWallAhead) {
   const Twist2 slower = SafetyFilter({0.4, 0.0}, Pose2(), farther, params, 0.2, 0.1, &limited);
   EXPECT_TRUE(limited);
   EXPECT_EQ(slower.v_mps, 0.2);
-  // Turning in place there is safe (the wall is ahead of the body).
-  const Twist2 turn = SafetyFilter({0.0, 1.0}, Pose2(), wall, params, 0.2, 0.1, &limited);
+  // Turning in place is safe with the wall 0.1 m ahead of h (the grown
+  // body's front corners swing about 3 cm forward while the turn is held for
+  // the period plus the wheels' lag; at 0.06 m they would touch).
+  std::vector<Eigen::Vector2d> ahead;
+  for (double y = -1.0; y <= 1.0; y += 0.02) ahead.emplace_back(0.10, y);
+  const Twist2 turn = SafetyFilter({0.0, 1.0}, Pose2(), ahead, params, 0.2, 0.1, &limited);
   EXPECT_FALSE(limited);
   EXPECT_EQ(turn.w_radps, 1.0);
 }
@@ -112,6 +116,29 @@ TEST(SafetyFilterTest, LongCommandPeriodStopsEarlier) {
   EXPECT_FALSE(limited);
   SafetyFilter({0.4, 0.0}, Pose2(), wall, params, 0.2, 0.7, &limited);
   EXPECT_TRUE(limited);
+}
+
+TEST(SafetyFilterTest, WheelDiscsArePartOfTheFootprint) {
+  ExplorerParams params;
+  // Beside the right wheel, outside the body rectangle (|y| > 0.19) but
+  // inside the wheel's collision disc (0.165 + 0.0975 = 0.2625).
+  const std::vector<Eigen::Vector2d> beside{{-0.2025, -0.24}};
+  EXPECT_TRUE(BodyTouches(Pose2(), beside, params, 0.0));
+  ExplorerParams no_wheels = params;
+  no_wheels.wheel_radius_m = 0.0;
+  EXPECT_FALSE(BodyTouches(Pose2(), beside, no_wheels, 0.0));
+
+  // A door jamb: a wall 0.25 m to the right of h's line that ends 0.15 m
+  // behind the axle (office, seed 5: backing up out of a door, the right
+  // wheel's disc caught the jamb; the body rectangle alone keeps clear).
+  std::vector<Eigen::Vector2d> jamb;
+  for (double x = -1.5; x <= -0.35 + 1e-9; x += 0.01) jamb.emplace_back(x, -0.25);
+  bool limited = false;
+  SafetyFilter({-0.1, 0.0}, Pose2(), jamb, no_wheels, 0.2025, 0.3, &limited);
+  EXPECT_FALSE(limited);
+  const Twist2 u = SafetyFilter({-0.1, 0.0}, Pose2(), jamb, params, 0.2025, 0.3, &limited);
+  EXPECT_TRUE(limited);
+  EXPECT_GT(u.v_mps, -0.1);  // slower or stopped
 }
 
 TEST(ExplorerParamsTest, DefaultsAreValidAndBadValuesAreNamed) {
