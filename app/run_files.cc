@@ -48,21 +48,6 @@ void WriteJsonAtomically(const std::string& path, const nlohmann::json& value) {
   WriteFileAtomically(path, value.dump(2) + "\n");
 }
 
-void MergeJsonFile(const std::string& path, const nlohmann::json& patch) {
-  nlohmann::json value = nlohmann::json::object();
-  if (std::filesystem::exists(path)) {
-    std::ifstream in(path);
-    try {
-      value = nlohmann::json::parse(in);
-    } catch (const nlohmann::json::exception& error) {
-      throw std::runtime_error(path + ": not valid JSON: " + error.what());
-    }
-    if (!value.is_object()) throw std::runtime_error(path + ": expected a JSON object");
-  }
-  value.merge_patch(patch);
-  WriteJsonAtomically(path, value);
-}
-
 std::string HashFile(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) throw std::runtime_error(path + ": cannot read");

@@ -14,12 +14,6 @@ void WriteFileAtomically(const std::string& path, const std::string& contents);
 /// Pretty-printed JSON, written atomically.
 void WriteJsonAtomically(const std::string& path, const nlohmann::json& value);
 
-/// Reads `path` (a JSON object, or missing), merges `patch` into it (RFC 7396
-/// merge patch: objects merge key by key, other values replace) and writes it
-/// back atomically. Several writers add their own keys to summary.json this
-/// way. Throws std::runtime_error naming the file if it is not a JSON object.
-void MergeJsonFile(const std::string& path, const nlohmann::json& patch);
-
 /// Content hash of a file: "fnv1a64:<16 hex digits>". Throws if unreadable.
 std::string HashFile(const std::string& path);
 
