@@ -174,20 +174,25 @@ int main(int argc, char** argv) {
       options.command_line = JoinArguments(argc, argv);
       options.show_progress = !quiet;
       options.stop_requested = &g_stop_requested;
+      // The video is rendered as the run goes; the final image, the plots and
+      // the page come after the evaluation, from the run's files.
+      const bool render = config.render.enabled && !no_render;
+      options.render_video = render && config.render.video;
       const mjslam::app::RunResult result = mjslam::app::RunSimulation(config, options);
       std::fprintf(stderr, "%s: %s after %d steps (%.1f s simulated)\n", options.out_dir.c_str(),
                    result.status.c_str(), result.steps, result.sim_time_s);
       if (result.status == "completed" && !no_evaluate) {
         mjslam::app::EvaluateRunDirectory(options.out_dir, mjslam::app::EvaluateOptions{});
       }
-      if (result.status == "completed" && config.render.enabled && !no_render) {
+      if (result.status == "completed" && render) {
         mjslam::app::RenderOptions render_options;
         render_options.show_progress = !quiet;
         render_options.stop_requested = &g_stop_requested;
-        const mjslam::app::RenderResult rendered =
-            mjslam::app::RenderRun(options.out_dir, config.render, render_options);
-        std::fprintf(stderr, "%s: rendered (%d video frames, %.0f frames/s)\n", options.out_dir.c_str(),
-                     rendered.video_frames, rendered.video_fps);
+        mjslam::renders::RenderParams after_run = config.render;
+        after_run.video = false;  // already written during the run
+        mjslam::app::RenderRun(options.out_dir, after_run, render_options);
+        std::fprintf(stderr, "%s: rendered (%d video frames during the run, %.0f frames/s)\n",
+                     options.out_dir.c_str(), result.video_frames, result.video_fps);
       }
       return result.status == "completed" ? 0 : 130;
     }

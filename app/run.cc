@@ -1,11 +1,13 @@
 #include "app/run.h"
 
+#include <algorithm>
 #include <cmath>
 #include <exception>
 #include <filesystem>
 #include <optional>
 
 #include "app/csv_writer.h"
+#include "app/live_video.h"
 #include "app/progress.h"
 #include "app/run_files.h"
 #include "app/slam_pair.h"
@@ -125,6 +127,8 @@ RunResult RunSimulation(const RunConfig& config, const RunOptions& options) {
     const double dt = 1.0 / config.run.control_rate_hz;
     SlamPair slam(config.slam, config.control, dt, X_WR0, X_RS);
     TrueCoverage coverage(simulator.Obstacles(), (X_WR0 * Pose2(-a_m, 0.0, 0.0)).translation());
+    std::optional<LiveVideo> video;
+    if (options.render_video) video.emplace(config, dir);
 
     CsvWriter trajectory(dir + "/trajectory.csv", TrajectoryColumns());
     CsvWriter scans(dir + "/scans.csv", ScanColumns(config.laser.num_beams));
@@ -233,6 +237,10 @@ RunResult RunSimulation(const RunConfig& config, const RunOptions& options) {
       result.steps = step + 1;
       result.sim_time_s = t;
       progress.Update(step);
+      if (video) {
+        video->Step(t, X_WR, slam, record.has_scan ? &record.scan : nullptr, simulator.X_WS(),
+                    explorer ? &*explorer : nullptr);
+      }
       if (finished) break;
       if (step < num_steps) {
         simulator.Advance(dt);
@@ -243,6 +251,11 @@ RunResult RunSimulation(const RunConfig& config, const RunOptions& options) {
       }
     }
     progress.Finish();
+    // An interrupted run leaves no video (its writer removes the temporary file).
+    if (video && result.status == "completed") {
+      result.video_frames = video->Finish();
+      result.video_fps = result.video_frames / std::max(video->wall_s(), 1e-9);
+    }
     trajectory.Flush();
     scans.Flush();
     if (explorer_csv) explorer_csv->Flush();

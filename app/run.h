@@ -17,6 +17,8 @@ struct RunOptions {
   std::string command_line;
   /// Draw a progress bar on a terminal.
   bool show_progress = true;
+  /// Render video.mp4 as the run goes (config.render's size and rate).
+  bool render_video = false;
   /// Set asynchronously (by a signal handler) to stop the run early; the run
   /// then ends cleanly with status "interrupted".
   const volatile std::sig_atomic_t* stop_requested = nullptr;
@@ -28,6 +30,10 @@ struct RunResult {
   std::string status;
   int steps = 0;
   double sim_time_s = 0.0;
+  /// Frames of video.mp4 rendered as the run went (0: none), and frames per
+  /// second of the wall time spent rendering and encoding them.
+  int video_frames = 0;
+  double video_fps = 0.0;
 };
 
 /// Runs one closed-loop simulation: MuJoCo steps the robot, the laser is cast
