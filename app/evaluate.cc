@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "app/csv_writer.h"
+#include "app/map_csv.h"
 #include "app/run_config.h"
 #include "app/run_files.h"
 #include "common/rng.h"
@@ -61,64 +62,6 @@ eval::Map RunGroundTruth(const std::string& run_dir, const eval::GroundTruthPara
   }
 }
 
-eval::Map ReadMapCsv(const std::string& path) {
-  const CsvTable table = ReadCsv(path, {"type"});
-  const int id = table.ColumnIndex("id");
-  table.ColumnIndex("type");  // throws when missing
-  const int p0 = table.ColumnIndex("p0");
-  const int c00 = table.ColumnIndex("c00");
-  const int ax = table.ColumnIndex("ax");
-  eval::Map map;
-  for (std::size_t r = 0; r < table.rows.size(); ++r) {
-    const std::vector<double>& row = table.rows[r];
-    const std::string& kind = table.text[r][0];  // the only text column
-    const std::string where = path + ":" + std::to_string(r + 2) + ": ";
-    eval::MapFeature f;
-    f.id = static_cast<int>(row[id]);
-    if (kind == "line") {
-      f.type = eval::MapFeature::Type::kLine;
-    } else if (kind == "corner") {
-      f.type = eval::MapFeature::Type::kCorner;
-    } else {
-      throw std::runtime_error(where + "type: expected line or corner (got '" + kind + "')");
-    }
-    f.params = {row[p0], row[p0 + 1]};
-    f.covariance << row[c00], row[c00 + 1], row[c00 + 1], row[c00 + 2];
-    if (!f.params.allFinite() || !f.covariance.allFinite()) {
-      throw std::runtime_error(where + "p0, p1, c00, c01, c11: expected numbers");
-    }
-    f.has_segment = f.type == eval::MapFeature::Type::kLine && std::isfinite(row[ax]) &&
-                    std::isfinite(row[ax + 1]) && std::isfinite(row[ax + 2]) &&
-                    std::isfinite(row[ax + 3]);
-    if (f.has_segment) {
-      f.p_WA = {row[ax], row[ax + 1]};
-      f.p_WB = {row[ax + 2], row[ax + 3]};
-    }
-    map.push_back(f);
-  }
-  return map;
-}
-
-void WriteEvalMapCsv(const std::string& path, const eval::Map& map) {
-  std::string text = "id,type,p0,p1,c00,c01,c11,ax,ay,bx,by\n";
-  for (const eval::MapFeature& f : map) {
-    const bool line = f.type == eval::MapFeature::Type::kLine;
-    text += std::to_string(f.id) + (line ? ",line," : ",corner,");
-    for (const double v : {f.params.x(), f.params.y(), f.covariance(0, 0), f.covariance(0, 1),
-                           f.covariance(1, 1)}) {
-      text += FormatDouble(v) + ",";
-    }
-    if (line && f.has_segment) {
-      text += FormatDouble(f.p_WA.x()) + "," + FormatDouble(f.p_WA.y()) + "," +
-              FormatDouble(f.p_WB.x()) + "," + FormatDouble(f.p_WB.y());
-    } else {
-      text += ",,,";
-    }
-    text += "\n";
-  }
-  WriteFileAtomically(path, text);
-}
-
 std::vector<eval::PoseStepMetrics> PoseSteps(const CsvTable& trajectory, const std::string& name) {
   const int truth = trajectory.ColumnIndex("true_x");
   const int estimate = trajectory.ColumnIndex(name + "_x");
@@ -155,7 +98,7 @@ RunEvaluation EvaluateRunDirectory(const std::string& run_dir, const EvaluateOpt
   if (manifest.is_null()) throw std::runtime_error(run_dir + "/manifest.json: missing");
   RunEvaluation result;
   result.truth = RunGroundTruth(run_dir, options.ground_truth);
-  WriteEvalMapCsv(run_dir + "/ground_truth_map.csv", result.truth);
+  WriteMapCsv(run_dir + "/ground_truth_map.csv", result.truth);
 
   // Poses and maps of both filters.
   const CsvTable trajectory = ReadCsv(run_dir + "/trajectory.csv");

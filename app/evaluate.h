@@ -49,16 +49,6 @@ struct RunEvaluation {
 /// cannot be loaded.
 eval::Map RunGroundTruth(const std::string& run_dir, const eval::GroundTruthParams& params = {});
 
-/// Reads a map CSV (map_classical.csv, map_selective.csv,
-/// ground_truth_map.csv). Throws std::runtime_error naming the file, line and
-/// value for an unknown type or a missing field.
-eval::Map ReadMapCsv(const std::string& path);
-
-/// Writes a map as CSV in the columns of the filters' maps
-/// (id,type,p0,p1,c00,c01,c11,ax,ay,bx,by), atomically. Corner kinds are not
-/// written (the columns have no place for them).
-void WriteEvalMapCsv(const std::string& path, const eval::Map& map);
-
 /// The pose NEES (3 dof) of filter `name` at every row of a trajectory.csv
 /// table: its `<name>_nees` column when present, else computed from the
 /// estimate, the truth and the covariance columns (NaN where the covariance

@@ -14,8 +14,10 @@
 #include <vector>
 
 #include "app/csv_reader.h"
+#include "app/map_csv.h"
 #include "app/progress.h"
 #include "app/run_config.h"
+#include "app/scene_frame.h"
 #include "renders/scene_renderer.h"
 #include "renders/video_writer.h"
 
@@ -29,8 +31,6 @@ namespace fs = std::filesystem;
 
 // One filter's columns of trajectory.csv.
 struct FilterColumns {
-  std::string name;
-  renders::Rgb color;
   int x, y, th, pxx, pxy, pyy;
 };
 
@@ -78,21 +78,9 @@ std::vector<ExplorerSnapshot> ReadExplorer(const std::string& path) {
   return snapshots;
 }
 
+// The map of a map CSV file into `layer` (none when the file is missing).
 void ReadMap(const std::string& path, renders::FilterLayer* layer) {
-  if (!fs::exists(path)) return;
-  const CsvTable table = ReadCsv(path, {"type"});
-  table.ColumnIndex("type");  // the only text column: text[r][0]
-  const int p0 = table.ColumnIndex("p0"), p1 = table.ColumnIndex("p1");
-  const int ax = table.ColumnIndex("ax"), ay = table.ColumnIndex("ay");
-  const int bx = table.ColumnIndex("bx"), by = table.ColumnIndex("by");
-  for (std::size_t r = 0; r < table.rows.size(); ++r) {
-    const std::vector<double>& row = table.rows[r];
-    if (table.text[r][0] == "corner") {
-      layer->corners.emplace_back(row[p0], row[p1]);
-    } else if (std::isfinite(row[ax]) && std::isfinite(row[bx])) {
-      layer->lines.push_back({{row[ax], row[ay]}, {row[bx], row[by]}});
-    }
-  }
+  if (fs::exists(path)) SetMapLayer(ReadMapCsv(path), layer);
 }
 
 constexpr char kPython[] = "/usr/bin/python3";
@@ -144,35 +132,26 @@ RenderResult RenderRun(const std::string& run_dir, const renders::RenderParams& 
   const int t_col = trajectory.ColumnIndex("t");
   const int true_x = trajectory.ColumnIndex("true_x"), true_y = trajectory.ColumnIndex("true_y");
   const int true_th = trajectory.ColumnIndex("true_th");
+  renders::SceneFrame frame;
+  frame.filters = FilterLayers();
   std::vector<FilterColumns> filters;
-  for (const auto& [name, color] : {std::pair<std::string, renders::Rgb>{"classical", renders::colors::kClassical},
-                                    std::pair<std::string, renders::Rgb>{"selective", renders::colors::kSelective}}) {
-    filters.push_back({name, color, trajectory.ColumnIndex(name + "_x"), trajectory.ColumnIndex(name + "_y"),
+  for (const renders::FilterLayer& layer : frame.filters) {
+    const std::string& name = layer.name;
+    filters.push_back({trajectory.ColumnIndex(name + "_x"), trajectory.ColumnIndex(name + "_y"),
                        trajectory.ColumnIndex(name + "_th"), trajectory.ColumnIndex(name + "_pxx"),
                        trajectory.ColumnIndex(name + "_pxy"), trajectory.ColumnIndex(name + "_pyy")});
   }
   const int scan_t = scans.ColumnIndex("t"), scan_x = scans.ColumnIndex("x");
   const int scan_y = scans.ColumnIndex("y"), scan_th = scans.ColumnIndex("th");
   const int scan_r0 = scans.ColumnIndex("r0");
-  const int num_beams = static_cast<int>(scans.columns.size()) - scan_r0;
 
   renders::SceneRenderer renderer(config.run.world, config.run.robot_model, config.sim, config.robot,
                                   params.width, params.height);
-  // Paths keep a point once it is a pixel away from the last one kept.
-  const double pixel_m = std::abs(renderer.PixelOf({0.0, 0.0}).x() - renderer.PixelOf({1.0, 0.0}).x());
-  const double min_step_m = 1.0 / std::max(pixel_m, 1e-9);
-
-  renders::SceneFrame frame;
+  const double min_step_m = PixelSizeM(renderer);
   frame.ellipse_scale = params.ellipse_scale;
-  for (const FilterColumns& f : filters) {
-    renders::FilterLayer layer;
-    layer.name = f.name;
-    layer.color = f.color;
-    frame.filters.push_back(layer);
-  }
   std::size_t next_row = 0;
   auto append = [&](std::vector<Eigen::Vector2d>* path, const Eigen::Vector2d& p, bool last) {
-    if (path->empty() || (p - path->back()).norm() >= min_step_m || last) path->push_back(p);
+    AppendPathPoint(path, p, min_step_m, last);
   };
   // Advances the frame to time T: paths, poses, current scan and explorer sets.
   auto advance_to = [&](double T) {
@@ -191,18 +170,16 @@ RenderResult RenderRun(const std::string& run_dir, const renders::RenderParams& 
       }
       ++next_row;
     }
-    frame.laser_hits.clear();
     const auto scan = std::upper_bound(scans.rows.begin(), scans.rows.end(), T + 1e-9,
                                        [&](double value, const std::vector<double>& row) { return value < row[scan_t]; });
     if (scan != scans.rows.begin()) {
       const std::vector<double>& row = *(scan - 1);
-      const Pose2 X_WS(row[scan_x], row[scan_y], row[scan_th]);
-      for (int i = 0; i < num_beams; ++i) {
-        const double range = row[scan_r0 + i];
-        if (!(range < config.laser.max_range_m)) continue;
-        const double bearing = config.laser.AngleMinRad() + i * config.laser.AngleIncrementRad();
-        frame.laser_hits.push_back(X_WS * Eigen::Vector2d(range * std::cos(bearing), range * std::sin(bearing)));
-      }
+      frame.laser_hits = LaserHits(Pose2(row[scan_x], row[scan_y], row[scan_th]),
+                                   std::vector<double>(row.begin() + scan_r0, row.end()),
+                                   config.laser.max_range_m, config.laser.AngleMinRad(),
+                                   config.laser.AngleIncrementRad());
+    } else {
+      frame.laser_hits.clear();
     }
     frame.explorer.reset();
     const auto snapshot = std::upper_bound(explorer.begin(), explorer.end(), T + 1e-9,
@@ -225,7 +202,7 @@ RenderResult RenderRun(const std::string& run_dir, const renders::RenderParams& 
       advance_to(last ? end_t : k * frame_dt);
       if (last) {
         for (std::size_t i = 0; i < filters.size(); ++i) {
-          ReadMap((dir / ("map_" + filters[i].name + ".csv")).string(), &frame.filters[i]);
+          ReadMap((dir / ("map_" + frame.filters[i].name + ".csv")).string(), &frame.filters[i]);
         }
       }
       video.AddFrame(renderer.Render(frame));
@@ -240,11 +217,8 @@ RenderResult RenderRun(const std::string& run_dir, const renders::RenderParams& 
 
   // The final image: the whole run with both final maps.
   advance_to(end_t);
-  for (std::size_t i = 0; i < filters.size(); ++i) {
-    renders::FilterLayer& layer = frame.filters[i];
-    layer.lines.clear();
-    layer.corners.clear();
-    ReadMap((dir / ("map_" + filters[i].name + ".csv")).string(), &layer);
+  for (renders::FilterLayer& layer : frame.filters) {
+    ReadMap((dir / ("map_" + layer.name + ".csv")).string(), &layer);
   }
   renders::WritePng((dir / "final.png").string(), renderer.Render(frame));
 

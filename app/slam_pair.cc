@@ -4,7 +4,7 @@
 #include <cmath>
 #include <string>
 
-#include "app/run_files.h"
+#include "app/map_csv.h"
 #include "eval/pose_metrics.h"
 #include "slam/feature_extraction.h"
 
@@ -22,10 +22,10 @@ double MicrosecondsSince(Clock::time_point start) {
 SlamPair::SlamPair(const slam::SlamParams& params, const ControlParams& control, double dt_s,
                    const Pose2& X_WR0, const Pose2& X_RS)
     : params_(params), control_(control), dt_s_(dt_s) {
-  filters_.push_back(
-      {"classical", slam::EkfSlam(params.ekf, slam::CorrectionMode::kClassical, X_WR0, X_RS)});
-  filters_.push_back(
-      {"selective", slam::EkfSlam(params.ekf, slam::CorrectionMode::kSelective, X_WR0, X_RS)});
+  filters_.emplace_back(
+      "classical", slam::EkfSlam(params.ekf, slam::CorrectionMode::kClassical, X_WR0, X_RS));
+  filters_.emplace_back(
+      "selective", slam::EkfSlam(params.ekf, slam::CorrectionMode::kSelective, X_WR0, X_RS));
 }
 
 void SlamPair::Step(const SensorRecord& record) {
@@ -94,28 +94,8 @@ void SlamPair::AddColumns(const Pose2& X_WR_true, CsvWriter* writer) const {
 
 void SlamPair::WriteMaps(const std::string& dir) const {
   for (const Filter& f : filters_) {
-    WriteMapCsv(dir + "/map_" + f.name + ".csv", f.filter.Map());
+    WriteMapCsv(dir + "/map_" + f.name + ".csv", ToEvalMap(f.filter.Map()));
   }
-}
-
-void WriteMapCsv(const std::string& path, const std::vector<slam::MapFeature>& map) {
-  std::string text = "id,type,p0,p1,c00,c01,c11,ax,ay,bx,by\n";
-  for (const slam::MapFeature& feature : map) {
-    const bool line = feature.type == slam::MapFeature::Type::kLine;
-    text += std::to_string(feature.id) + (line ? ",line," : ",corner,");
-    for (const double v : {feature.params.x(), feature.params.y(), feature.covariance(0, 0),
-                           feature.covariance(0, 1), feature.covariance(1, 1)}) {
-      text += FormatDouble(v) + ",";
-    }
-    if (line && feature.has_segment) {
-      text += FormatDouble(feature.p_WA.x()) + "," + FormatDouble(feature.p_WA.y()) + "," +
-              FormatDouble(feature.p_WB.x()) + "," + FormatDouble(feature.p_WB.y());
-    } else {
-      text += ",,,";
-    }
-    text += "\n";
-  }
-  WriteFileAtomically(path, text);
 }
 
 }  // namespace mjslam::app

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "app/control.h"
@@ -57,6 +58,8 @@ class SlamPair {
 
  private:
   struct Filter {
+    Filter(std::string name_in, slam::EkfSlam filter_in)
+        : name(std::move(name_in)), filter(std::move(filter_in)) {}
     std::string name;
     slam::EkfSlam filter;
     slam::StepReport report;
@@ -72,9 +75,5 @@ class SlamPair {
   double dt_s_;
   std::vector<Filter> filters_;
 };
-
-/// Writes one filter map as CSV (id,type,p0,p1,c00,c01,c11,ax,ay,bx,by),
-/// atomically.
-void WriteMapCsv(const std::string& path, const std::vector<slam::MapFeature>& map);
 
 }  // namespace mjslam::app

@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 
 #include "app/evaluate.h"
+#include "app/map_csv.h"
 #include "app/run_config.h"
 #include "app/sweep.h"
 #include "tests/integration/run_helpers.h"

@@ -1,0 +1,62 @@
+// The map CSV files: a filter's map written and read back unchanged.
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+
+#include "app/map_csv.h"
+
+namespace mjslam::app {
+namespace {
+
+TEST(MapCsvTest, FilterMapRoundTripsBitForBit) {
+  slam::MapFeature line;
+  line.id = 3;
+  line.type = slam::MapFeature::Type::kLine;
+  line.params = {2.0 / 3.0, -0.1};
+  line.covariance << 1e-6, 2e-7, 2e-7, 3e-8;
+  line.has_segment = true;
+  line.p_WA = {0.1, 1.0 / 7.0};
+  line.p_WB = {-4.0, 0.7};
+  slam::MapFeature corner;
+  corner.id = 8;
+  corner.type = slam::MapFeature::Type::kCorner;
+  corner.params = {1.25, -3.5};
+  corner.covariance << 4e-4, -1e-5, -1e-5, 9e-4;
+
+  const std::string path =
+      (std::filesystem::temp_directory_path() / "mjslam_map_csv_test.csv").string();
+  WriteMapCsv(path, ToEvalMap({line, corner}));
+  const eval::Map map = ReadMapCsv(path);
+  ASSERT_EQ(map.size(), 2u);
+  EXPECT_EQ(map[0].id, 3);
+  EXPECT_EQ(map[0].type, eval::MapFeature::Type::kLine);
+  EXPECT_EQ(map[0].params, line.params);
+  EXPECT_EQ(map[0].covariance, line.covariance);
+  EXPECT_TRUE(map[0].has_segment);
+  EXPECT_EQ(map[0].p_WA, line.p_WA);
+  EXPECT_EQ(map[0].p_WB, line.p_WB);
+  EXPECT_EQ(map[1].id, 8);
+  EXPECT_EQ(map[1].type, eval::MapFeature::Type::kCorner);
+  EXPECT_EQ(map[1].params, corner.params);
+  EXPECT_EQ(map[1].covariance, corner.covariance);
+  EXPECT_FALSE(map[1].has_segment);
+  std::filesystem::remove(path);
+}
+
+TEST(MapCsvTest, UnknownTypeIsAnErrorNamingFileAndLine) {
+  const std::string path =
+      (std::filesystem::temp_directory_path() / "mjslam_map_csv_bad.csv").string();
+  std::ofstream(path) << "id,type,p0,p1,c00,c01,c11,ax,ay,bx,by\n0,wall,1,0,1,0,1,,,,\n";
+  try {
+    ReadMapCsv(path);
+    FAIL() << "no error";
+  } catch (const std::runtime_error& error) {
+    EXPECT_NE(std::string(error.what()).find(path + ":2: type"), std::string::npos) << error.what();
+    EXPECT_NE(std::string(error.what()).find("wall"), std::string::npos) << error.what();
+  }
+  std::filesystem::remove(path);
+}
+
+}  // namespace
+}  // namespace mjslam::app
