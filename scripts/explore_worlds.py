@@ -3,9 +3,10 @@
 prints the table of issue 4 (README, "Exploring the shipped worlds").
 
     scripts/explore_worlds.py [--out DIR] [--runs N] [--jobs J] [--worlds W ...]
+                              [--set KEY=VALUE ...]
 
 Runs `build/mjslam sweep` once per world (seeds run.seed + 0 .. N-1, into
-DIR/<world>/runs/), then reads each run's summary.json and trajectory.csv. A
+DIR/<world>/runs/; each --set is passed on to the sweep), then reads each run's summary.json and trajectory.csv. A
 world passes when no run has a collision, every run has seen at least 95 % of
 the reachable free area, and both filters keep the pose error inside 2 sigma
 for at least 90 % of the steps per component, the steps of its runs pooled. Exit status 0 when every world passes, 1 otherwise.
@@ -23,12 +24,14 @@ WORLDS = ["room", "corridor_loop", "office", "pillars"]
 FILTERS = ["classical", "selective"]
 
 
-def sweep(world, out, runs, jobs):
+def sweep(world, out, runs, jobs, overrides):
     command = [os.path.join(ROOT, "build", "mjslam"), "sweep",
                "--config", os.path.join(ROOT, "configs", "default.yaml"),
                "--runs", str(runs), "--jobs", str(jobs), "--out", out, "--quiet",
                "--divergence-points", "0",
                "--set", "run.world=" + os.path.join(ROOT, "worlds", world + ".xml")]
+    for override in overrides:
+        command += ["--set", override]
     subprocess.run(command, check=True, stdout=sys.stderr)
 
 
@@ -57,6 +60,8 @@ def main():
     parser.add_argument("--runs", type=int, default=5)
     parser.add_argument("--jobs", type=int, default=2)
     parser.add_argument("--worlds", nargs="+", default=WORLDS)
+    parser.add_argument("--set", action="append", default=[], metavar="KEY=VALUE",
+                        help="config override passed to every run")
     args = parser.parse_args()
 
     header = ("| world | runs | collisions | explored (min) | end | time (mean) "
@@ -65,7 +70,7 @@ def main():
     all_pass = True
     for world in args.worlds:
         out = os.path.join(args.out, world)
-        sweep(world, out, args.runs, args.jobs)
+        sweep(world, out, args.runs, args.jobs, args.set)
         runs_dir = os.path.join(out, "runs")
         summaries = []
         steps = 0

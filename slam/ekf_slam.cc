@@ -257,11 +257,27 @@ StepReport EkfSlam::Step(const SensorRecord& record, const ScanFeatures* feature
     if (observation.type == FeatureType::kLine) GrowSegment(matched[m].feature, observation);
   }
 
-  // New features from the corrected pose (inverse observation models).
+  // New features from the corrected pose (inverse observation models). The
+  // lines come first, so a new corner can be placed where its lines are.
+  std::vector<int> line_feature(num_lines, -1);
+  for (int i = 0; i < num_lines; ++i) {
+    if (association.outcome[i] == AssociationOutcome::kMatched) line_feature[i] = association.feature[i];
+  }
   for (int i = 0; i < report.num_observed; ++i) {
     if (association.outcome[i] != AssociationOutcome::kNew) continue;
     const Observation& observation = observations[i];
-    const int k = state_.AddFeature(observation.type, observation.z, observation.R);
+    int k = -1;
+    if (i >= num_lines && params_.corners_from_map_lines) {
+      const CornerObservation& corner = features->corners[i - num_lines];
+      const int a = corner.line_a >= 0 && corner.line_a < num_lines ? line_feature[corner.line_a] : -1;
+      const int b = corner.line_b >= 0 && corner.line_b < num_lines ? line_feature[corner.line_b] : -1;
+      if (a >= 0 && b >= 0 && a != b) {
+        k = state_.AddLineIntersection(a, b);
+        ++report.num_corners_from_lines;
+      }
+    }
+    if (k < 0) k = state_.AddFeature(observation.type, observation.z, observation.R);
+    if (i < num_lines) line_feature[i] = k;
     info_.push_back({next_id_++, LineSegment{}});
     if (observation.type == FeatureType::kLine) {
       const Pose2 X_WS = X_WR() * state_.X_RS();

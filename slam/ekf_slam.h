@@ -40,6 +40,9 @@ struct StepReport {
   int num_updated = 0;
   /// Observations that became new features.
   int num_new = 0;
+  /// New corners placed where their two map lines meet, not from their own
+  /// observation (EkfParams::corners_from_map_lines); counted in num_new.
+  int num_corners_from_lines = 0;
   /// Observations neither matched nor added (lost a contest for a feature,
   /// or between the gate and the new-feature threshold).
   int num_ambiguous = 0;

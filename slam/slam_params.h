@@ -137,6 +137,14 @@ struct EkfParams {
   /// out of the correction; corners with a new or unmatched line still
   /// correct (slam/README.md, departure 11).
   bool correct_corners_of_matched_lines = false;
+  /// Whether a new corner whose two lines are in the map after the step
+  /// (matched, or new in the same scan) is added as the intersection of
+  /// those map lines, correlated with them (SlamState::AddLineIntersection).
+  /// The corner is fitted to the same points as its lines, so its own
+  /// observation holds nothing they do not. false: it is added from its
+  /// observation as an independent feature, as in the paper, and the map
+  /// counts the scan's information twice (slam/README.md, departure 12).
+  bool corners_from_map_lines = true;
   /// MAX of the paper's Algorithm 2: the most features used per correction by
   /// the selective filter (>= 1). Ignored by the classical filter.
   int max_updates = 2;
@@ -157,6 +165,7 @@ struct EkfParams {
     a->Visit(MJSLAM_NVP(gate_probability));
     a->Visit(MJSLAM_NVP(new_feature_probability));
     a->Visit(MJSLAM_NVP(correct_corners_of_matched_lines));
+    a->Visit(MJSLAM_NVP(corners_from_map_lines));
     a->Visit(MJSLAM_NVP(max_updates));
   }
   /// Every out-of-range field, keys relative to this struct (nested ones as

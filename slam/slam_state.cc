@@ -6,6 +6,7 @@
 #include "common/angles.h"
 #include "common/check.h"
 #include "slam/fast_wrap.h"
+#include "slam/feature_extraction.h"
 
 namespace mjslam::slam {
 namespace {
@@ -142,6 +143,36 @@ int SlamState::AddFeature(FeatureType type, const Eigen::Vector2d& z, const Eige
   x_.conservativeResize(n_ + 2);
   x_.segment<2>(j) = f;
   types_.push_back(type);
+  n_ += 2;
+  return num_features() - 1;
+}
+
+int SlamState::AddLineIntersection(int a, int b) {
+  MJSLAM_CHECK(a >= 0 && a < num_features() && b >= 0 && b < num_features() && a != b);
+  MJSLAM_CHECK(types_[a] == FeatureType::kLine && types_[b] == FeatureType::kLine);
+  Eigen::Matrix<double, 2, 4> J;
+  const Eigen::Vector2d f = IntersectLines(feature(a), feature(b), &J);
+  const int ia = FeatureIndex(a);
+  const int ib = FeatureIndex(b);
+
+  const int j = n_;
+  Reserve(n_ + 2);
+
+  // Cross-covariance with everything so far, P_fx = J P_(ab)x, written as
+  // columns (P symmetric): P_xf = P_x(ab) J^T.
+  P_.block(0, j, n_, 2).noalias() = P_.block(0, ia, n_, 2) * J.leftCols<2>().transpose();
+  P_.block(0, j, n_, 2).noalias() += P_.block(0, ib, n_, 2) * J.rightCols<2>().transpose();
+  P_.block(j, 0, 2, n_) = P_.block(0, j, n_, 2).transpose();
+
+  // The feature's own block, J P_(ab)(ab) J^T = P_f(ab) J^T.
+  Eigen::Matrix2d P_ff;
+  P_ff.noalias() = P_.block<2, 2>(j, ia) * J.leftCols<2>().transpose();
+  P_ff.noalias() += P_.block<2, 2>(j, ib) * J.rightCols<2>().transpose();
+  P_.block<2, 2>(j, j) = 0.5 * (P_ff + P_ff.transpose());
+
+  x_.conservativeResize(n_ + 2);
+  x_.segment<2>(j) = f;
+  types_.push_back(FeatureType::kCorner);
   n_ += 2;
   return num_features() - 1;
 }

@@ -102,6 +102,14 @@ class SlamState {
   /// O(n) (amortised: the buffer doubles when full). Returns the new index k.
   int AddFeature(FeatureType type, const Eigen::Vector2d& z, const Eigen::Matrix2d& R);
 
+  /// Augments the state with the corner where map lines a and b meet, a
+  /// function of the state: f = IntersectLines(f_a, f_b) = c, P_fx = J P_(ab)x,
+  /// P_ff = J P_(ab)(ab) J^T with J = d c / d(f_a, f_b). It adds no
+  /// information: the corner is exactly as uncertain as its lines, and
+  /// correlated with them. O(n) (amortised). Returns the new index k.
+  /// Precondition (checked): a != b are lines that are not parallel.
+  int AddLineIntersection(int a, int b);
+
   /// One sequential EKF correction (Algorithm 1, sentences iv-vi) with
   /// observation z of feature k, covariance R (SPD):
   ///   nu = z - h(xi) (angle wrapped; a line's h in z's polar form),

@@ -16,6 +16,7 @@
 #include "common/params.h"
 #include "slam/data_association.h"
 #include "slam/slam_params.h"
+#include "slam/slam_state.h"
 
 namespace mjslam::slam {
 namespace {
@@ -265,6 +266,58 @@ TEST(EkfSlamTest, CornerOfTwoMatchedLinesDoesNotCorrectTwice) {
   EXPECT_EQ(report.num_new, 1);
   EXPECT_EQ(report.num_redundant_corners, 0);
   EXPECT_EQ(report.num_updated, 2);
+}
+
+TEST(EkfSlamTest, NewCornerIsWhereItsMapLinesMeetAndMovesWithThem) {
+  // Two walls meeting at (2, 1.5) and their corner, seen from the known
+  // start; the corner's own observation is 1 cm off the lines' meeting point
+  // (inside its noise). From the map lines (default), the corner is their
+  // meeting point and is correlated with them, so a later correction of one
+  // line moves it too; from its own observation, it stays where it was seen.
+  for (const bool from_lines : {true, false}) {
+    EkfParams params;
+    params.corners_from_map_lines = from_lines;
+    EkfSlam filter(params, CorrectionMode::kClassical, Pose2(), Pose2());
+    ScanFeatures first;
+    first.lines.push_back(Line(2.0, 0.0, {2.0, -1.0}, {2.0, 1.5}));
+    first.lines.push_back(Line(1.5, kPi / 2.0, {0.0, 1.5}, {2.0, 1.5}));
+    CornerObservation corner = Corner(std::hypot(2.01, 1.5), std::atan2(1.5, 2.01));
+    corner.line_a = 0;
+    corner.line_b = 1;
+    first.corners.push_back(corner);
+    StepReport report = filter.Step(Still(), &first);
+    EXPECT_EQ(report.num_new, 3);
+    EXPECT_EQ(report.num_corners_from_lines, from_lines ? 1 : 0);
+    const Eigen::Vector2d seen = filter.Map()[2].params;
+    EXPECT_NEAR(seen.x(), from_lines ? 2.0 : 2.01, 1e-9);
+    EXPECT_NEAR(seen.y(), 1.5, 1e-9);
+    const Eigen::Matrix2d corner_line = filter.covariance().block<2, 2>(
+        SlamState::FeatureIndex(2), SlamState::FeatureIndex(0));
+    if (from_lines) {
+      // x of the corner is rho - 1.5 alpha of the east wall (x cos al +
+      // y sin al = rho at y = 1.5, al = 0).
+      EXPECT_NEAR(corner_line(0, 0), kRhoStd * kRhoStd, 1e-12);
+      EXPECT_NEAR(filter.Map()[2].covariance(0, 0),
+                  kRhoStd * kRhoStd + 1.5 * 1.5 * kAlphaStd * kAlphaStd, 1e-12);
+    } else {
+      EXPECT_EQ(corner_line.cwiseAbs().maxCoeff(), 0.0);  // known pose: independent
+    }
+
+    // The east wall alone, seen 5 mm further: the wall moves out, and the
+    // corner with it only if it was placed from the lines.
+    ScanFeatures second;
+    second.lines.push_back(Line(2.005, 0.0, {2.005, -1.0}, {2.005, 1.5}));
+    report = filter.Step(Still(), &second);
+    ASSERT_EQ(report.num_matched, 1);
+    const double wall_moved = filter.Map()[0].params.x() - 2.0;
+    const double corner_moved = filter.Map()[2].params.x() - seen.x();
+    EXPECT_GT(wall_moved, 0.001);
+    if (from_lines) {
+      EXPECT_NEAR(corner_moved, wall_moved, 1e-9);
+    } else {
+      EXPECT_NEAR(corner_moved, 0.0, 1e-9);
+    }
+  }
 }
 
 TEST(EkfSlamTest, GatesByMahalanobisDistanceWithADuplicateGuard) {

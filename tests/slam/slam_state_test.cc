@@ -7,6 +7,7 @@
 #include <cmath>
 #include <vector>
 
+#include <Eigen/LU>
 #include <gtest/gtest.h>
 
 #include "common/angles.h"
@@ -149,6 +150,63 @@ TEST(SlamStateTest, AugmentationEqualsDenseComputation) {
     EXPECT_EQ(state.dimension(), n + 2);
     EXPECT_LT((state.feature(k) - f).norm(), 1e-15);
     EXPECT_LT((state.covariance() - expected).cwiseAbs().maxCoeff(), 1e-15);
+  }
+}
+
+// Where the lines (r, al) a and b meet, solved by Eigen's LU, for the
+// reference below.
+Eigen::Vector2d MeetingPoint(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  Eigen::Matrix2d normals;
+  normals << std::cos(a.y()), std::sin(a.y()), std::cos(b.y()), std::sin(b.y());
+  return normals.partialPivLu().solve(Eigen::Vector2d(a.x(), b.x()));
+}
+
+// A corner placed where two map lines meet is a function of the state:
+// xi' = [xi; c(f_a, f_b)], P' = G P G^T with G = [I; dc/dxi], dc/dxi here by
+// central differences. The corner is correlated with its lines and, through
+// them, with the pose.
+TEST(SlamStateTest, LineIntersectionEqualsDenseComputation) {
+  Rng rng(24);
+  for (int trial = 0; trial < 10; ++trial) {
+    SlamState state = MakeState(&rng, 6);
+    const int a = 2 * (trial % 3);        // lines are the even features
+    const int b = 2 * ((trial + 1) % 3);
+    const Eigen::MatrixXd P = state.covariance();
+    const int n = state.dimension();
+    const Eigen::Vector2d c = MeetingPoint(state.feature(a), state.feature(b));
+
+    Eigen::MatrixXd G = Eigen::MatrixXd::Zero(n + 2, n);
+    G.topRows(n).setIdentity();
+    const double step = 1e-6;
+    for (int i = 0; i < 4; ++i) {
+      const int column = SlamState::FeatureIndex(i < 2 ? a : b) + i % 2;
+      Eigen::Vector2d fa_plus = state.feature(a), fa_minus = state.feature(a);
+      Eigen::Vector2d fb_plus = state.feature(b), fb_minus = state.feature(b);
+      Eigen::Vector2d& plus = i < 2 ? fa_plus : fb_plus;
+      Eigen::Vector2d& minus = i < 2 ? fa_minus : fb_minus;
+      plus(i % 2) += step;
+      minus(i % 2) -= step;
+      G.block<2, 1>(n, column) =
+          (MeetingPoint(fa_plus, fb_plus) - MeetingPoint(fa_minus, fb_minus)) / (2.0 * step);
+    }
+    const Eigen::MatrixXd expected = G * P * G.transpose();
+
+    const int k = state.AddLineIntersection(a, b);
+    EXPECT_EQ(k, 6);
+    EXPECT_EQ(state.feature_type(k), FeatureType::kCorner);
+    EXPECT_EQ(state.dimension(), n + 2);
+    EXPECT_LT((state.feature(k) - c).norm(), 1e-9) << "trial " << trial;
+    // Central differences are good to about 1e-8 relative here.
+    EXPECT_LT((state.covariance() - expected).cwiseAbs().maxCoeff(),
+              1e-7 * expected.cwiseAbs().maxCoeff())
+        << "trial " << trial;
+    EXPECT_EQ(state.covariance(), state.covariance().transpose());
+    // The corner's block is as uncertain as its lines make it, not zero, and
+    // it is correlated with line a.
+    EXPECT_GT(state.feature_covariance(k).trace(), 0.0);
+    const Eigen::Matrix2d corner_line_a =
+        state.covariance().block<2, 2>(SlamState::FeatureIndex(k), SlamState::FeatureIndex(a));
+    EXPECT_GT(corner_line_a.cwiseAbs().maxCoeff(), 0.0);
   }
 }
 
