@@ -193,6 +193,7 @@ StepReport EkfSlam::Step(const SensorRecord& record, const ScanFeatures* feature
   }
   const double slip_std = params_.lateral_slip_std_m_per_rad * std::abs(input.increment.y());
   input.lateral_variance_m2 = slip_std * slip_std;
+  if (record.dt_s > 0.0) input.skid_per_m_rad = params_.lateral_skid_s / record.dt_s;
   std::vector<Observation> observations;
   if (features != nullptr) observations = CollectObservations(*features);
 

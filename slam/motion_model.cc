@@ -8,7 +8,8 @@
 namespace mjslam::slam {
 
 Eigen::Vector3d PredictPose(const Eigen::Vector3d& pose_WR, const Eigen::Vector2d& increment,
-                            double a_m, Eigen::Matrix3d* A, Eigen::Matrix<double, 3, 2>* W) {
+                            double a_m, Eigen::Matrix3d* A, Eigen::Matrix<double, 3, 2>* W,
+                            double skid_per_m_rad) {
   const double d = increment.x();
   const double dth = increment.y();
   const double half = 0.5 * dth;
@@ -25,7 +26,8 @@ Eigen::Vector3d PredictPose(const Eigen::Vector3d& pose_WR, const Eigen::Vector2
     dsinc = 0.5 * (half * std::cos(half) - std::sin(half)) / (half * half);
   }
   const double chord = d * sinc;
-  const double lateral = 2.0 * a_m * std::sin(half);
+  // Sideways: the point h swinging about the axle, and the skid outward.
+  const double lateral = 2.0 * a_m * std::sin(half) - skid_per_m_rad * d * dth;
   const double dx = chord * cm - lateral * sm;
   const double dy = chord * sm + lateral * cm;
   const Eigen::Vector3d predicted(pose_WR.x() + dx, pose_WR.y() + dy,
@@ -36,9 +38,10 @@ Eigen::Vector3d PredictPose(const Eigen::Vector3d& pose_WR, const Eigen::Vector2
     (*A)(1, 2) = dx;
   }
   if (W != nullptr) {
-    const double dlat = a_m * std::cos(half);
-    *W << sinc * cm, d * dsinc * cm - dlat * sm - 0.5 * dy,
-          sinc * sm, d * dsinc * sm + dlat * cm + 0.5 * dx,
+    const double dlat_dd = -skid_per_m_rad * dth;
+    const double dlat_dth = a_m * std::cos(half) - skid_per_m_rad * d;
+    *W << sinc * cm - dlat_dd * sm, d * dsinc * cm - dlat_dth * sm - 0.5 * dy,
+          sinc * sm + dlat_dd * cm, d * dsinc * sm + dlat_dth * cm + 0.5 * dx,
           0.0, 1.0;
   }
   return predicted;

@@ -20,17 +20,25 @@ struct MotionInput {
   /// across the mid-arc heading th + dth / 2 that Eq. (6) does not model,
   /// independent of `increment` (EkfParams::lateral_slip_std_m_per_rad).
   double lateral_variance_m2 = 0.0;
+  /// Skid to the outside of the turn, per metre and radian of `increment`:
+  /// R moves by -skid d dth across the mid-arc heading (EkfParams::lateral_skid_s
+  /// divided by dt). 0: Eq. (6) alone.
+  double skid_per_m_rad = 0.0;
 };
 
 /// The paper's Eq. (6) for the point of control h (frame R, `a_m` ahead of
 /// the wheel axle), pose (x, y, th) of R in W and increment (d, dth) = (u dt,
 /// w dt):
 ///   x' = x + d cos th - a dth sin th,  y' = y + d sin th + a dth cos th,
-///   th' = wrap(th + dth).
+///   th' = wrap(th + dth),
+/// integrated exactly (the axle centre on an arc, slam/README.md departure
+/// 9), plus a skid of -skid_per_m_rad d dth across the mid-arc heading
+/// (MotionInput::skid_per_m_rad).
 /// If not null, `A` receives d pose' / d pose and `W` d pose' / d increment.
 Eigen::Vector3d PredictPose(const Eigen::Vector3d& pose_WR, const Eigen::Vector2d& increment,
                             double a_m, Eigen::Matrix3d* A = nullptr,
-                            Eigen::Matrix<double, 3, 2>* W = nullptr);
+                            Eigen::Matrix<double, 3, 2>* W = nullptr,
+                            double skid_per_m_rad = 0.0);
 
 /// The command held over `dt_s` (>= 0) as an input: increment (v dt, w dt),
 /// covariance diag((dt sigma_v)^2, (dt sigma_w)^2) with

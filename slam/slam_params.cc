@@ -36,6 +36,7 @@ std::vector<ParamProblem> EkfParams::Validate() const {
   check.Merge("command_noise", command_noise.Validate());
   check.Merge("odometry_noise", odometry_noise.Validate());
   check.NonNegative("lateral_slip_std_m_per_rad", lateral_slip_std_m_per_rad);
+  check.NonNegative("lateral_skid_s", lateral_skid_s);
   check.NonNegative("initial_position_std_m", initial_position_std_m);
   check.NonNegative("initial_heading_std_rad", initial_heading_std_rad);
   check.NonNegative("extra_line_rho_std_m", extra_line_rho_std_m);

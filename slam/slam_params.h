@@ -96,13 +96,18 @@ struct EkfParams {
   /// Input noise when `input` is "odometry".
   OdometryNoiseParams odometry_noise;
   /// Lateral slip of R per radian turned, one standard deviation, metres per
-  /// radian, with either input: Eq. (6) has no sideways motion, but tyres
-  /// skid outward in turns. The prediction adds (k |dth|)^2 of variance
-  /// across the mid-arc heading. The simulator's robot skids about 0.0088 s
-  /// times v w sideways (0.2-0.3 mm per 0.1 s step in a 1.2 rad/s turn,
-  /// 2-3 mm per radian), always outward; the default covers that systematic
-  /// drift as noise (slam/README.md, departure 10).
+  /// radian, with either input: what the skid below leaves unmodelled. The
+  /// prediction adds (k |dth|)^2 of variance across the mid-arc heading
+  /// (slam/README.md, departure 10).
   double lateral_slip_std_m_per_rad = 0.005;
+  /// Sideways skid of the axle centre in turns, seconds: Eq. (6) has no
+  /// sideways motion, but tyres skid to the outside of a turn at a speed
+  /// proportional to the centripetal acceleration, c v w. The prediction
+  /// moves R by c d dth / dt across the mid-arc heading, to the outside
+  /// (d, dth: the step's increment; nothing when dt = 0). 0: Eq. (6) as in
+  /// the paper. The default is the simulated Pioneer's, measured from the
+  /// true motion (slam/README.md, departure 13).
+  double lateral_skid_s = 0.0102;
 
   /// Standard deviation of the initial position of R, metres (0: known start,
   /// as in the paper).
@@ -156,6 +161,7 @@ struct EkfParams {
     a->Visit(MJSLAM_NVP(command_noise));
     a->Visit(MJSLAM_NVP(odometry_noise));
     a->Visit(MJSLAM_NVP(lateral_slip_std_m_per_rad));
+    a->Visit(MJSLAM_NVP(lateral_skid_s));
     a->Visit(MJSLAM_NVP(initial_position_std_m));
     a->Visit(MJSLAM_NVP(initial_heading_std_rad));
     a->Visit(MJSLAM_NVP(extra_line_rho_std_m));

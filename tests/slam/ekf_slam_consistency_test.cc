@@ -74,7 +74,10 @@ RunErrors Run(CorrectionMode mode, std::uint64_t seed, double reported_variance_
       const Eigen::Vector2d true_increment(
           command.increment.x() + motion_rng.Gaussian(0.0, std::sqrt(command.covariance(0, 0))),
           command.increment.y() + motion_rng.Gaussian(0.0, std::sqrt(command.covariance(1, 1))));
-      truth = PredictPose(truth, true_increment, params.control_point_offset_m);
+      // The robot skids outward in the turn as the filter's model says
+      // (EkfParams::lateral_skid_s); the wheel encoders do not see it.
+      truth = PredictPose(truth, true_increment, params.control_point_offset_m, nullptr, nullptr,
+                          params.lateral_skid_s / kDt);
       // Wheel odometry: the true increment plus noise from the odometry model,
       // composed as Eq. (6) moves R (so OdometryInput recovers it exactly).
       const Eigen::Matrix2d Q = OdometryInput(Pose2(), Pose2(true_increment.x(), 0.0,

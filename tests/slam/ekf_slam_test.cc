@@ -155,32 +155,49 @@ TEST(EkfSlamTest, PredictsFromCommands) {
 
 TEST(EkfSlamTest, PredictsFromOdometry) {
   // Odometry generated with Eq. (6)'s own kinematics, (d, a dth, dth) per
-  // record in the previous R frame: the filter must reproduce it exactly.
-  EkfParams params;
-  params.input = "odometry";
-  params.control_point_offset_m = 0.15;
-  const Pose2 X_WR0(3.0, -1.0, 0.4);
-  EkfSlam filter(params, CorrectionMode::kSelective, X_WR0, Pose2());
-  Pose2 X_OR;
-  SensorRecord record;
-  for (int i = 0; i < 50; ++i) {
-    const double d = 0.05;
-    const double dth = 0.04 * std::sin(0.1 * i);
-    if (i > 0) {
-      const Eigen::Vector3d step = PredictPose(Eigen::Vector3d::Zero(), Eigen::Vector2d(d, dth),
-                                               params.control_point_offset_m);
-      X_OR = X_OR * Pose2(step.x(), step.y(), step.z());
+  // record in the previous R frame: without skid, the filter must reproduce
+  // it exactly; with skid, it must add c d dth / dt outward in every step.
+  for (const double skid_s : {0.0, 0.01}) {
+    EkfParams params;
+    params.input = "odometry";
+    params.lateral_skid_s = skid_s;
+    params.control_point_offset_m = 0.15;
+    const Pose2 X_WR0(3.0, -1.0, 0.4);
+    EkfSlam filter(params, CorrectionMode::kSelective, X_WR0, Pose2());
+    Pose2 X_OR;
+    Pose2 X_true = X_WR0;  // R in W, moved as the filter's model moves it
+    SensorRecord record;
+    for (int i = 0; i < 50; ++i) {
+      const double d = 0.05;
+      const double dth = 0.04 * std::sin(0.1 * i);
+      if (i > 0) {
+        const Eigen::Vector3d step = PredictPose(Eigen::Vector3d::Zero(), Eigen::Vector2d(d, dth),
+                                                 params.control_point_offset_m);
+        X_OR = X_OR * Pose2(step.x(), step.y(), step.z());
+      }
+      record.dt_s = i == 0 ? 0.0 : 0.1;
+      record.X_OR = X_OR;
+      record.command = Twist2{100.0, 100.0};  // ignored
+      filter.Step(record, nullptr);
+      if (i > 0) {
+        const Eigen::Vector3d step = PredictPose(Eigen::Vector3d::Zero(), Eigen::Vector2d(d, dth),
+                                                 params.control_point_offset_m, nullptr, nullptr,
+                                                 skid_s / record.dt_s);
+        X_true = X_true * Pose2(step.x(), step.y(), step.z());
+      }
     }
-    record.dt_s = i == 0 ? 0.0 : 0.1;
-    record.X_OR = X_OR;
-    record.command = Twist2{100.0, 100.0};  // ignored
-    filter.Step(record, nullptr);
+    EXPECT_NEAR(filter.X_WR().x, X_true.x, 1e-9) << "skid " << skid_s;
+    EXPECT_NEAR(filter.X_WR().y, X_true.y, 1e-9) << "skid " << skid_s;
+    EXPECT_NEAR(WrapAngle(filter.X_WR().theta - X_true.theta), 0.0, 1e-9) << "skid " << skid_s;
+    // The skid is 0.01 / 0.1 * 0.05 * |dth| <= 0.2 mm a step.
+    const double off = (filter.X_WR().translation() - (X_WR0 * X_OR).translation()).norm();
+    if (skid_s > 0.0) {
+      EXPECT_GT(off, 1e-4);
+    } else {
+      EXPECT_LT(off, 1e-9);
+    }
+    EXPECT_GT(filter.pose_covariance().determinant(), 0.0);
   }
-  const Pose2 expected = X_WR0 * X_OR;
-  EXPECT_NEAR(filter.X_WR().x, expected.x, 1e-9);
-  EXPECT_NEAR(filter.X_WR().y, expected.y, 1e-9);
-  EXPECT_NEAR(WrapAngle(filter.X_WR().theta - expected.theta), 0.0, 1e-9);
-  EXPECT_GT(filter.pose_covariance().determinant(), 0.0);
 }
 
 TEST(EkfSlamTest, OdometryFrameIsArbitrary) {

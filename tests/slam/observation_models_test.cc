@@ -278,19 +278,44 @@ TEST(MotionModelTest, PredictionIntegratesEquationSixExactly) {
   EXPECT_NEAR(wrapped.z(), 3.2 - 2.0 * kPi, 1e-12);
 }
 
+TEST(MotionModelTest, SkidMovesROutwardAcrossTheMidArcHeading) {
+  // Heading 0, d = 0.3, dth = 0.1 (a left turn), skid 0.05 per metre and
+  // radian: R ends 0.05 * 0.3 * 0.1 = 1.5 mm further right, across the
+  // mid-arc heading 0.05, than without skid; the heading is unchanged.
+  const Eigen::Vector3d pose(1.0, 2.0, 0.0);
+  const Eigen::Vector2d increment(0.3, 0.1);
+  const Eigen::Vector3d plain = PredictPose(pose, increment, 0.2);
+  const Eigen::Vector3d skidded = PredictPose(pose, increment, 0.2, nullptr, nullptr, 0.05);
+  const Eigen::Vector2d shift = (skidded - plain).head<2>();
+  EXPECT_NEAR(shift.x(), 1.5e-3 * std::sin(0.05), 1e-15);
+  EXPECT_NEAR(shift.y(), -1.5e-3 * std::cos(0.05), 1e-15);
+  EXPECT_EQ(skidded.z(), plain.z());
+  // A right turn skids to the left; no turn or no distance, no skid.
+  const Eigen::Vector3d right = PredictPose(pose, Eigen::Vector2d(0.3, -0.1), 0.2, nullptr, nullptr, 0.05);
+  const Eigen::Vector3d right_plain = PredictPose(pose, Eigen::Vector2d(0.3, -0.1), 0.2);
+  EXPECT_GT(right.y() - right_plain.y(), 1e-3);
+  EXPECT_EQ(PredictPose(pose, Eigen::Vector2d(0.3, 0.0), 0.2, nullptr, nullptr, 0.05),
+            PredictPose(pose, Eigen::Vector2d(0.3, 0.0), 0.2));
+  EXPECT_EQ(PredictPose(pose, Eigen::Vector2d(0.0, 0.1), 0.2, nullptr, nullptr, 0.05),
+            PredictPose(pose, Eigen::Vector2d(0.0, 0.1), 0.2));
+}
+
 TEST(MotionModelTest, JacobiansAAndWMatchCentralDifferences) {
   Rng rng(16);
   for (int trial = 0; trial < 100; ++trial) {
     const Eigen::Vector3d pose = RandomPose(&rng);
     const Eigen::Vector2d increment(rng.Gaussian(0.0, 0.5), rng.Gaussian(0.0, 0.5));
     const double a = 0.05 + 0.3 * rng.Uniform();
+    const double skid = trial % 2 == 0 ? 0.0 : 0.2 * rng.Uniform();  // with and without
     Eigen::Matrix3d A;
     Eigen::Matrix<double, 3, 2> W;
-    PredictPose(pose, increment, a, &A, &W);
+    PredictPose(pose, increment, a, &A, &W, skid);
     const Eigen::Matrix3d numerical_A = NumericalJacobian<3, 3>(
-        [&](const Eigen::Vector3d& p) { return PredictPose(p, increment, a); }, pose, {2});
+        [&](const Eigen::Vector3d& p) { return PredictPose(p, increment, a, nullptr, nullptr, skid); },
+        pose, {2});
     const Eigen::Matrix<double, 3, 2> numerical_W = NumericalJacobian<3, 2>(
-        [&](const Eigen::Vector2d& u) { return PredictPose(pose, u, a); }, increment, {2});
+        [&](const Eigen::Vector2d& u) { return PredictPose(pose, u, a, nullptr, nullptr, skid); },
+        increment, {2});
     EXPECT_LT((A - numerical_A).cwiseAbs().maxCoeff(), kJacobianTolerance) << "trial " << trial;
     EXPECT_LT((W - numerical_W).cwiseAbs().maxCoeff(), kJacobianTolerance) << "trial " << trial;
   }
