@@ -270,8 +270,9 @@ StepReport EkfSlam::Step(const SensorRecord& record, const ScanFeatures* feature
     int k = -1;
     if (i >= num_lines && params_.corners_from_map_lines) {
       const CornerObservation& corner = features->corners[i - num_lines];
-      const int a = corner.line_a >= 0 && corner.line_a < num_lines ? line_feature[corner.line_a] : -1;
-      const int b = corner.line_b >= 0 && corner.line_b < num_lines ? line_feature[corner.line_b] : -1;
+      auto map_line = [&](int line) { return line >= 0 && line < num_lines ? line_feature[line] : -1; };
+      const int a = map_line(corner.line_a);
+      const int b = map_line(corner.line_b);
       if (a >= 0 && b >= 0 && a != b) {
         k = state_.AddLineIntersection(a, b);
         ++report.num_corners_from_lines;

@@ -140,11 +140,7 @@ int SlamState::AddFeature(FeatureType type, const Eigen::Vector2d& z, const Eige
   P_ff.noalias() += G_z * R * G_z.transpose();
   P_.block<2, 2>(j, j) = 0.5 * (P_ff + P_ff.transpose());
 
-  x_.conservativeResize(n_ + 2);
-  x_.segment<2>(j) = f;
-  types_.push_back(type);
-  n_ += 2;
-  return num_features() - 1;
+  return Append(type, f);
 }
 
 int SlamState::AddLineIntersection(int a, int b) {
@@ -170,9 +166,13 @@ int SlamState::AddLineIntersection(int a, int b) {
   P_ff.noalias() += P_.block<2, 2>(j, ib) * J.rightCols<2>().transpose();
   P_.block<2, 2>(j, j) = 0.5 * (P_ff + P_ff.transpose());
 
+  return Append(FeatureType::kCorner, f);
+}
+
+int SlamState::Append(FeatureType type, const Eigen::Vector2d& f) {
   x_.conservativeResize(n_ + 2);
-  x_.segment<2>(j) = f;
-  types_.push_back(FeatureType::kCorner);
+  x_.segment<2>(n_) = f;
+  types_.push_back(type);
   n_ += 2;
   return num_features() - 1;
 }

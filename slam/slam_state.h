@@ -128,6 +128,9 @@ class SlamState {
  private:
   // Makes room for `n` state entries, doubling the buffer if needed.
   void Reserve(int n);
+  // Ends an augmentation whose P rows and columns are written: appends the
+  // mean f of a feature of `type` and returns its index.
+  int Append(FeatureType type, const Eigen::Vector2d& f);
 
   Pose2 X_RS_;
   int n_ = 3;

@@ -98,9 +98,10 @@ TEST(ConsistencyCheckTest, DetectsMeasurementNoiseUnderstatedTenTimes) {
 // runs, seeds 1..10, each until exploration ends (about 67 s): in the turns,
 // neither filter's average NEES may go above its upper bound (for the runs
 // still going at that step) for more than 5 % of the steps. Measured: 0.001
-// (classical) and 0 (selective) of 674 steps above, mean ANEES 2.28 and 2.26 (slightly underconfident). Without
-// the skid in the prediction (slam.ekf.lateral_skid_s=0, slam/README.md
-// departure 13) the selective filter is above for 0.108 of the steps.
+// (classical) and 0 (selective) of 674 steps above, mean ANEES 2.28 and 2.26
+// (slightly underconfident). Without the skid in the prediction
+// (slam.ekf.lateral_skid_s=0, slam/README.md departure 13) the selective
+// filter is above for 0.108 of the steps.
 TEST(ClosedLoopConsistencyTest, NeitherFilterIsOverconfidentInTheExplorersTurns) {
   const nlohmann::json summary = SweepOf(
       "closed_loop", 10,

@@ -247,6 +247,19 @@ TEST(EkfSlamTest, FirstScanAddsFeaturesAndTheSecondMatchesThem) {
   }
 }
 
+// Two walls meeting at (2, 1.5), seen from the origin, and their corner,
+// observed at x = corner_x (2 where the lines meet).
+ScanFeatures TwoWallsAndTheirCorner(double corner_x = 2.0) {
+  ScanFeatures features;
+  features.lines.push_back(Line(2.0, 0.0, {2.0, -1.0}, {2.0, 1.5}));
+  features.lines.push_back(Line(1.5, kPi / 2.0, {0.0, 1.5}, {2.0, 1.5}));
+  CornerObservation corner = Corner(std::hypot(corner_x, 1.5), std::atan2(1.5, corner_x));
+  corner.line_a = 0;
+  corner.line_b = 1;
+  features.corners.push_back(corner);
+  return features;
+}
+
 TEST(EkfSlamTest, CornerOfTwoMatchedLinesDoesNotCorrectTwice) {
   // Two walls meeting at (2, 1.5) and their corner. On the second look both
   // lines match, so the corner adds nothing new: it is matched but left out
@@ -255,13 +268,7 @@ TEST(EkfSlamTest, CornerOfTwoMatchedLinesDoesNotCorrectTwice) {
     EkfParams params;
     params.correct_corners_of_matched_lines = correct_anyway;
     EkfSlam filter(params, CorrectionMode::kClassical, Pose2(), Pose2());
-    ScanFeatures features;
-    features.lines.push_back(Line(2.0, 0.0, {2.0, -1.0}, {2.0, 1.5}));
-    features.lines.push_back(Line(1.5, kPi / 2.0, {0.0, 1.5}, {2.0, 1.5}));
-    CornerObservation corner = Corner(std::hypot(2.0, 1.5), std::atan2(1.5, 2.0));
-    corner.line_a = 0;
-    corner.line_b = 1;
-    features.corners.push_back(corner);
+    const ScanFeatures features = TwoWallsAndTheirCorner();
     filter.Step(Still(), &features);
     const StepReport report = filter.Step(Still(), &features);
     EXPECT_EQ(report.num_matched, 3);
@@ -270,15 +277,11 @@ TEST(EkfSlamTest, CornerOfTwoMatchedLinesDoesNotCorrectTwice) {
   }
   // A corner whose line is new this time still corrects.
   EkfSlam filter(EkfParams(), CorrectionMode::kClassical, Pose2(), Pose2());
-  ScanFeatures first;
-  first.lines.push_back(Line(2.0, 0.0, {2.0, -1.0}, {2.0, 1.5}));
-  CornerObservation corner = Corner(std::hypot(2.0, 1.5), std::atan2(1.5, 2.0));
-  corner.line_a = 0;
-  first.corners.push_back(corner);
+  const ScanFeatures second = TwoWallsAndTheirCorner();
+  ScanFeatures first = second;  // without the second wall
+  first.lines.pop_back();
+  first.corners[0].line_b = -1;
   filter.Step(Still(), &first);
-  ScanFeatures second = first;
-  second.lines.push_back(Line(1.5, kPi / 2.0, {0.0, 1.5}, {2.0, 1.5}));
-  second.corners[0].line_b = 1;
   const StepReport report = filter.Step(Still(), &second);
   EXPECT_EQ(report.num_new, 1);
   EXPECT_EQ(report.num_redundant_corners, 0);
@@ -286,8 +289,8 @@ TEST(EkfSlamTest, CornerOfTwoMatchedLinesDoesNotCorrectTwice) {
 }
 
 TEST(EkfSlamTest, NewCornerIsWhereItsMapLinesMeetAndMovesWithThem) {
-  // Two walls meeting at (2, 1.5) and their corner, seen from the known
-  // start; the corner's own observation is 1 cm off the lines' meeting point
+  // TwoWallsAndTheirCorner seen from the known start; the corner's own
+  // observation is 1 cm off the lines' meeting point
   // (inside its noise). From the map lines (default), the corner is their
   // meeting point and is correlated with them, so a later correction of one
   // line moves it too; from its own observation, it stays where it was seen.
@@ -295,13 +298,7 @@ TEST(EkfSlamTest, NewCornerIsWhereItsMapLinesMeetAndMovesWithThem) {
     EkfParams params;
     params.corners_from_map_lines = from_lines;
     EkfSlam filter(params, CorrectionMode::kClassical, Pose2(), Pose2());
-    ScanFeatures first;
-    first.lines.push_back(Line(2.0, 0.0, {2.0, -1.0}, {2.0, 1.5}));
-    first.lines.push_back(Line(1.5, kPi / 2.0, {0.0, 1.5}, {2.0, 1.5}));
-    CornerObservation corner = Corner(std::hypot(2.01, 1.5), std::atan2(1.5, 2.01));
-    corner.line_a = 0;
-    corner.line_b = 1;
-    first.corners.push_back(corner);
+    const ScanFeatures first = TwoWallsAndTheirCorner(2.01);
     StepReport report = filter.Step(Still(), &first);
     EXPECT_EQ(report.num_new, 3);
     EXPECT_EQ(report.num_corners_from_lines, from_lines ? 1 : 0);
