@@ -105,7 +105,7 @@ def plot_processing(traj, path):
         ax.plot(t, acc, color=COLORS[f], lw=1.5, label=f)
     ax.set_xlabel("time (s)")
     ax.set_ylabel("accumulated processing time (s)")
-    ax.set_title("Accumulated processing time, measured on this machine (feature extraction + filter step)")
+    ax.set_title("Accumulated processing time, measured on this machine\n(feature extraction + filter step)")
     ax.grid(True, alpha=0.3)
     ax.legend(loc="upper left")
     fig.tight_layout()
