@@ -1,8 +1,10 @@
 // The only file of mjslam that includes yaml-cpp: YAML text -> ConfigNode.
 
+#include <yaml-cpp/eventhandler.h>
 #include <yaml-cpp/yaml.h>
 
 #include <cstddef>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -89,14 +91,55 @@ class Converter {
   bool stopped_ = false;
 };
 
+// Records where each document starts; ignores everything else.
+class DocumentStarts : public YAML::EventHandler {
+ public:
+  void OnDocumentStart(const YAML::Mark& mark) override { starts.push_back(mark); }
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark&, YAML::anchor_t) override {}
+  void OnAlias(const YAML::Mark&, YAML::anchor_t) override {}
+  void OnScalar(const YAML::Mark&, const std::string&, YAML::anchor_t, const std::string&) override {}
+  void OnSequenceStart(const YAML::Mark&, const std::string&, YAML::anchor_t,
+                       YAML::EmitterStyle::value) override {}
+  void OnSequenceEnd() override {}
+  void OnMapStart(const YAML::Mark&, const std::string&, YAML::anchor_t,
+                  YAML::EmitterStyle::value) override {}
+  void OnMapEnd() override {}
+
+  std::vector<YAML::Mark> starts;
+};
+
+// Where the first two documents of `text` start (one config is one
+// document; a second one is an error, so counting stops there). yaml-cpp
+// 0.7.0 (Debian 12's) cannot be trusted with YAML::LoadAll: on a document
+// that starts with a flow indicator such as `,` its parser returns an empty
+// document without consuming the character, forever, and LoadAll allocates
+// until the machine runs out of memory. A document that starts where the
+// previous one did is that stuck parser: `*stuck` is set and counting stops.
+// Throws YAML::Exception on ordinary syntax errors.
+std::vector<YAML::Mark> DocumentStartMarks(const std::string& text, bool* stuck) {
+  std::istringstream stream(text);
+  YAML::Parser parser(stream);
+  DocumentStarts handler;
+  *stuck = false;
+  while (handler.starts.size() < 2 && parser.HandleNextDocument(handler)) {
+    const std::size_t n = handler.starts.size();
+    *stuck = n == 2 && handler.starts[1].pos == handler.starts[0].pos;
+  }
+  return handler.starts;
+}
+
 }  // namespace
 
 ConfigNode ParseYaml(const std::string& text, const std::string& source,
                      std::vector<ConfigProblem>* problems) {
   const SourceMark start{source, 1, 1};
-  std::vector<YAML::Node> documents;
+  std::vector<YAML::Mark> starts;
+  bool stuck = false;
+  YAML::Node document;
   try {
-    documents = YAML::LoadAll(text);
+    starts = DocumentStartMarks(text, &stuck);
+    if (!starts.empty() && !stuck) document = YAML::Load(text);  // the first document
   } catch (const YAML::Exception& error) {
     // yaml-cpp marks are 0-based.
     SourceMark mark{source, 0, 0};
@@ -110,20 +153,28 @@ ConfigNode ParseYaml(const std::string& text, const std::string& source,
     return null_node;
   }
 
-  // One document per configuration.
-  if (documents.size() > 1) {
-    Converter converter(source, problems);
-    problems->push_back({converter.Mark(documents[1].Mark(), start), "",
-                         "expected one YAML document (found " +
-                             std::to_string(documents.size()) + ")"});
-  }
-  if (documents.empty()) {
+  Converter converter(source, problems);
+  if (stuck) {
+    const SourceMark mark = converter.Mark(starts[1], start);
+    const std::size_t pos = static_cast<std::size_t>(starts[1].pos);
+    const std::string character = pos < text.size() ? text.substr(pos, 1) : std::string();
+    problems->push_back({mark, "",
+                         "YAML syntax error: a document cannot start with '" + character + "'"});
     ConfigNode null_node;
     null_node.mark = start;
     return null_node;
   }
-  Converter converter(source, problems);
-  return converter.Convert(documents.front(), start, 0);
+  // One document per configuration.
+  if (starts.size() > 1) {
+    problems->push_back({converter.Mark(starts[1], start), "",
+                         "expected one YAML document (a second one starts here)"});
+  }
+  if (starts.empty()) {
+    ConfigNode null_node;
+    null_node.mark = start;
+    return null_node;
+  }
+  return converter.Convert(document, start, 0);
 }
 
 }  // namespace mjslam::config

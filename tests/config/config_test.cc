@@ -2,7 +2,11 @@
 
 #include <gtest/gtest.h>
 
+#include <sys/resource.h>
+
 #include <algorithm>
+#include <cstdio>
+#include <cstdlib>
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
@@ -322,7 +326,42 @@ TEST(ConfigTest, YamlSyntaxErrorHasLineCol) {
 
 TEST(ConfigTest, MoreThanOneDocumentRejected) {
   EXPECT_TRUE(Contains(ErrorOf("rate_hz: 1\n---\nrate_hz: 2\n"),
-                       "x.yaml:3:1: expected one YAML document (found 2)"));
+                       "x.yaml:2:1: expected one YAML document (a second one starts here)"));
+}
+
+// In a child process with 1 GiB of address space: exits 0 when loading `yaml`
+// with `overrides` fails with a message containing `expected`, else 1.
+[[noreturn]] void ExitWithErrorCheck(const std::string& yaml,
+                                     const std::vector<std::string>& overrides,
+                                     const std::string& expected) {
+  const rlimit limit{rlim_t{1} << 30, rlim_t{1} << 30};
+  setrlimit(RLIMIT_AS, &limit);
+  const std::string message = ErrorOf(yaml, overrides);
+  std::fprintf(stderr, "%s\n", message.c_str());
+  std::exit(message.find(expected) != std::string::npos ? 0 : 1);
+}
+
+// yaml-cpp 0.7.0's LoadAll never returns on a document that starts with a
+// flow indicator (it allocated until the machine ran out of memory). Each
+// case runs in a child process with 1 GiB of address space, so a regression
+// fails here (killed or timed out) instead of taking the machine down.
+TEST(ConfigTest, DocumentStartingWithCommaIsSyntaxErrorInBoundedMemory) {
+  struct Case {
+    std::string yaml;
+    std::vector<std::string> overrides;
+    std::string expected;
+  };
+  const std::vector<Case> cases = {
+      {",", {}, "x.yaml:1:1: YAML syntax error: a document cannot start with ','"},
+      {",a: 1\n", {}, "x.yaml:1:1: YAML syntax error: a document cannot start with ','"},
+      {"rate_hz: 1\n---\n,\n", {}, "x.yaml:2:1: expected one YAML document"},
+      {"", {"rate_hz=,"}, "--set rate_hz=,: rate_hz: invalid YAML value: "},
+  };
+  for (const Case& c : cases) {
+    EXPECT_EXIT(ExitWithErrorCheck(c.yaml, c.overrides, c.expected), ::testing::ExitedWithCode(0),
+                "")
+        << "yaml: '" << c.yaml << "', expected: " << c.expected;
+  }
 }
 
 TEST(ConfigTest, RecursiveAliasRejectedNotFollowed) {
