@@ -9,7 +9,7 @@
 namespace mjslam::app {
 
 /// Who drives the robot, from which pose, and the paper's control period
-/// (method.md, item 3). Serialized under `control.*`.
+/// (docs/method.md, "Control period"). Serialized under `control.*`.
 struct ControlParams {
   /// "explorer" (the frontier explorer, closed loop) or "tour" (the built-in
   /// waypoint driver along the world's tour, from the true pose).

@@ -62,7 +62,7 @@ std::vector<double> PoseNees(const CsvTable& trajectory, const std::string& name
 /// seed). Merges the results into summary.json (created if missing; other
 /// writers' keys are kept): for each filter `filters.<f>.inside_2sigma`,
 /// `rmse` ({x, y, th}), `mean_nees`, `final_pose_error` ({x, y, th}),
-/// `num_features`, `map` {...}, and `divergence` {...} (README, "mjslam
+/// `num_features`, `map` {...}, and `divergence` {...} (docs/commands.md, "mjslam
 /// evaluate"). Files are written atomically. Throws std::runtime_error naming
 /// the file for a missing or malformed input.
 RunEvaluation EvaluateRunDirectory(const std::string& run_dir, const EvaluateOptions& options = {});

@@ -10,7 +10,7 @@ namespace mjslam::app {
 
 /// The map CSV files of a run directory (map_classical.csv,
 /// map_selective.csv, ground_truth_map.csv): one row per feature,
-/// id,type,p0,p1,c00,c01,c11,ax,ay,bx,by (README, "The run directory").
+/// id,type,p0,p1,c00,c01,c11,ax,ay,bx,by (docs/run_directory.md).
 
 /// A filter's map in eval's form (the same content).
 eval::Map ToEvalMap(const std::vector<slam::MapFeature>& map);

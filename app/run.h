@@ -39,7 +39,7 @@ struct RunResult {
 /// Runs one closed-loop simulation: MuJoCo steps the robot, the laser is cast
 /// at its rate, both filters run on every record, the driver steers. Writes
 /// config.yaml, manifest.json, trajectory.csv, scans.csv, map_classical.csv
-/// and map_selective.csv into `options.out_dir` (see the README). On an error
+/// and map_selective.csv into `options.out_dir` (docs/run_directory.md). On an error
 /// the files keep every complete row so far, the manifest records the
 /// failure, and the error is rethrown.
 RunResult RunSimulation(const RunConfig& config, const RunOptions& options);

@@ -73,7 +73,7 @@ SweepResult RunSweep(const RunConfig& config, const SweepOptions& options);
 /// The aggregate of the completed runs `run_dirs` of a sweep: writes
 /// out_dir/nees.csv (t,classical_anees,selective_anees,lower,upper,n_runs:
 /// per step, the average pose NEES over the runs that have it and the
-/// two-sided bounds for n_runs) and returns the summary (README, "mjslam
+/// two-sided bounds for n_runs) and returns the summary (docs/commands.md, "mjslam
 /// sweep"): per filter the fraction of steps inside, above and below the
 /// bounds, the mean ANEES, the verdict, accumulated processing time and
 /// (with f_period columns) open-loop time, and the mean of the runs' metrics.

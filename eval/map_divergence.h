@@ -11,7 +11,7 @@
 
 namespace mjslam::eval {
 
-/// How a map becomes a probability mass function (method.md, item 4).
+/// How a map becomes a probability mass function (docs/method.md, "Map divergence").
 struct DivergenceParams {
   /// Lines become Gaussians spaced at most this far apart along their
   /// segment (at least two per line), metres.

@@ -8,7 +8,7 @@ namespace mjslam::eval {
 
 /// One feature of a map as eval sees it (a filter's estimate or the ground
 /// truth), in the world frame W; the same content as a row of the map CSV
-/// files (README, "The run directory").
+/// files (docs/run_directory.md).
 struct MapFeature {
   enum class Type { kLine, kCorner };
   /// Kind of a true corner as seen from the free side: concave (inside

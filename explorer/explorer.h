@@ -41,7 +41,7 @@ struct ExplorerLogRow {
   double y_m = 0.0;
 };
 
-/// The frontier explorer (method.md "The explorer"; the paper's ref. [10]):
+/// The frontier explorer (docs/method.md, "The explorer"; the paper's ref. [10]):
 /// the one entry point the application calls at every control step.
 ///
 /// At each new scan it updates a log-odds occupancy grid at the estimated

@@ -12,7 +12,7 @@
 namespace mjslam::explorer {
 
 /// Local frontier points of one scan taken with the laser at `X_WS`, in W
-/// (the paper's "local frontier points", method.md "The explorer"):
+/// (the paper's "local frontier points", docs/method.md, "The explorer"):
 /// - an opening between two consecutive echoes at least `min_opening_m`
 ///   apart (a door seen past its jamb, a corridor branching off): the point
 ///   is the middle of the gap, moved `frontier_standoff_m` toward the laser;

@@ -5,7 +5,7 @@
     python3 renders/report.py sweep SWEEP_DIR
 
 Called by `mjslam render` (and `mjslam run` when render.enabled). Reads the
-files described in the top README ("The run directory"); the columns the
+files described in docs/run_directory.md; the columns the
 closed-loop integration adds (explored, f_period, f_open_loop, f_nees) and the files
 summary.json, explorer.csv, nees.csv, divergence.csv are optional. Every
 output is written to a temporary name and renamed. Exits 1 with a message

@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """Explores every shipped world with the default config, 5 seeds each, and
-prints the table of issue 4 (README, "Exploring the shipped worlds").
+prints the table of issue 4 (docs/results.md, "Exploring the shipped worlds").
 
     scripts/explore_worlds.py [--out DIR] [--runs N] [--jobs J] [--worlds W ...]
                               [--set KEY=VALUE ...] [--per-run]

@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """Measures the robot's sideways skid in turns from the true motion of runs,
-the figure behind slam.ekf.lateral_skid_s (slam/README.md, departure 13).
+the figure behind slam.ekf.lateral_skid_s (docs/method.md, departure 13).
 
     scripts/measure_skid.py RUN_DIR [RUN_DIR ...] [--offset A]
 

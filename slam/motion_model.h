@@ -31,7 +31,7 @@ struct MotionInput {
 /// w dt):
 ///   x' = x + d cos th - a dth sin th,  y' = y + d sin th + a dth cos th,
 ///   th' = wrap(th + dth),
-/// integrated exactly (the axle centre on an arc, slam/README.md departure
+/// integrated exactly (the axle centre on an arc, docs/method.md departure
 /// 9), plus a skid of -skid_per_m_rad d dth across the mid-arc heading
 /// (MotionInput::skid_per_m_rad).
 /// If not null, `A` receives d pose' / d pose and `W` d pose' / d increment.

@@ -80,7 +80,7 @@ Eigen::Vector2d InitializeFeature(FeatureType type, const Eigen::Vector3d& pose_
 /// crosses the line (rho = 0); a sensor near a wall's extension can see the
 /// line on one side while the estimate puts it on the other. Differencing the
 /// aligned forms is continuous there; away from rho = 0 it is exactly the
-/// canonical difference of method.md (both forms then agree within pi/2).
+/// canonical difference (docs/method.md, departure 4; both forms then agree within pi/2).
 bool AlignLineToObservation(const Eigen::Vector2d& z, Eigen::Vector2d* h,
                             Eigen::Matrix<double, 2, 3>* H_pose = nullptr,
                             Eigen::Matrix2d* H_feature = nullptr,

@@ -98,7 +98,7 @@ struct EkfParams {
   /// Lateral slip of R per radian turned, one standard deviation, metres per
   /// radian, with either input: what the skid below leaves unmodelled. The
   /// prediction adds (k |dth|)^2 of variance across the mid-arc heading
-  /// (slam/README.md, departure 10).
+  /// (docs/method.md, departure 10).
   double lateral_slip_std_m_per_rad = 0.005;
   /// Sideways skid of the axle centre in turns, seconds: Eq. (6) has no
   /// sideways motion, but tyres skid to the outside of a turn at a speed
@@ -106,7 +106,7 @@ struct EkfParams {
   /// moves R by c d dth / dt across the mid-arc heading, to the outside
   /// (d, dth: the step's increment; nothing when dt = 0). 0: Eq. (6) as in
   /// the paper. The default is the simulated Pioneer's, measured from the
-  /// true motion (slam/README.md, departure 13).
+  /// true motion (docs/method.md, departure 13).
   double lateral_skid_s = 0.0102;
 
   /// Standard deviation of the initial position of R, metres (0: known start,
@@ -140,7 +140,7 @@ struct EkfParams {
   /// information twice and makes the filter overconfident. false (default):
   /// such a corner is matched (and its segment bookkeeping kept) but left
   /// out of the correction; corners with a new or unmatched line still
-  /// correct (slam/README.md, departure 11).
+  /// correct (docs/method.md, departure 11).
   bool correct_corners_of_matched_lines = false;
   /// Whether a new corner whose two lines are in the map after the step
   /// (matched, or new in the same scan) is added as the intersection of
@@ -148,7 +148,7 @@ struct EkfParams {
   /// The corner is fitted to the same points as its lines, so its own
   /// observation holds nothing they do not. false: it is added from its
   /// observation as an independent feature, as in the paper, and the map
-  /// counts the scan's information twice (slam/README.md, departure 12).
+  /// counts the scan's information twice (docs/method.md, departure 12).
   bool corners_from_map_lines = true;
   /// MAX of the paper's Algorithm 2: the most features used per correction by
   /// the selective filter (>= 1). Ignored by the classical filter.

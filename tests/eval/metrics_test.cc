@@ -29,7 +29,7 @@ TEST(ChiSquareTest, QuantilesMatchTables) {
 }
 
 TEST(ChiSquareTest, AverageNeesBoundsMatchMethodReferenceValues) {
-  // method.md, item 1: pose, 3 dof, 95 % two-sided.
+  // docs/method.md, "Consistency: NEES and its bounds": pose, 3 dof, 95 % two-sided.
   const struct {
     int n;
     double lower, upper;

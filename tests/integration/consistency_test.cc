@@ -70,7 +70,7 @@ TEST_F(ConsistencyTest, SelectiveAverageNeesStaysInsideBoundsForMostSteps) {
 }
 
 // Measured: 0.975 of 119 steps inside, mean ANEES 2.68. With corners of
-// matched lines back in the correction (slam/README.md, departure 11) it
+// matched lines back in the correction (docs/method.md, departure 11) it
 // fails: 0.76 inside, 0.24 above the upper bound, mean ANEES 3.75.
 TEST_F(ConsistencyTest, ClassicalAverageNeesStaysInsideBoundsForMostSteps) {
   const nlohmann::json& s = (*summary_)["filters"]["classical"];
@@ -100,7 +100,7 @@ TEST(ConsistencyCheckTest, DetectsMeasurementNoiseUnderstatedTenTimes) {
 // still going at that step) for more than 5 % of the steps. Measured: 0.001
 // (classical) and 0 (selective) of 674 steps above, mean ANEES 2.28 and 2.26
 // (slightly underconfident). Without the skid in the prediction
-// (slam.ekf.lateral_skid_s=0, slam/README.md departure 13) the selective
+// (slam.ekf.lateral_skid_s=0, docs/method.md departure 13) the selective
 // filter is above for 0.108 of the steps.
 TEST(ClosedLoopConsistencyTest, NeitherFilterIsOverconfidentInTheExplorersTurns) {
   const nlohmann::json summary = SweepOf(
