@@ -444,6 +444,27 @@ TEST(CornerBetweenTest, RejectsLinesThatEndFarFromTheirIntersection) {
                             found.runs[1], found.lines[0], found.lines[1]));
 }
 
+TEST(CornerBetweenTest, RejectsPointsBetweenTheLinesBehindTheirLine) {
+  // The concave corner with the last 3 points of wall a (x = 2) taken from
+  // its run: on the wall they pass; 10 cm behind it (as where a box face
+  // ends in front of a wall) they make the pair an occlusion edge.
+  const FeatureExtractionParams params;
+  const LaserScan scan = ConcaveCornerScan();
+  const Lines found = LinesOf(scan, params);
+  ASSERT_EQ(found.lines.size(), 2u);
+  const NoiseModel noise = MakeNoiseModel(params);
+  Segment run_a = found.runs[0];
+  run_a.last -= 3;
+  std::vector<ScanPoint> points = found.points;
+  EXPECT_TRUE(CornerBetween(points, noise, params, scan.angle_increment_rad, run_a,
+                            found.runs[1], found.lines[0], found.lines[1]));
+  for (int i = run_a.last + 1; i <= run_a.last + 3; ++i) {
+    points[i] = Point(points[i].x + 0.1, points[i].y, points[i].beam);
+  }
+  EXPECT_FALSE(CornerBetween(points, noise, params, scan.angle_increment_rad, run_a,
+                             found.runs[1], found.lines[0], found.lines[1]));
+}
+
 TEST(CornerBetweenTest, RejectsLinesAtTooSmallAnAngle) {
   const FeatureExtractionParams params;
   const LaserScan scan = ConcaveCornerScan();
@@ -452,10 +473,16 @@ TEST(CornerBetweenTest, RejectsLinesAtTooSmallAnAngle) {
   const NoiseModel noise = MakeNoiseModel(params);
   ASSERT_TRUE(CornerBetween(found.points, noise, params, scan.angle_increment_rad, found.runs[0],
                             found.runs[1], found.lines[0], found.lines[1]));
-  // The same pair with line b turned to 20 degrees from line a (the
-  // smallest angle allowed is corner_min_angle_deg, 30).
+  // The same pair with line b turned about the vertex (2, 1) to 20 degrees
+  // from line a (x = 2): everything else still passes, but the smallest
+  // angle allowed is corner_min_angle_deg, 30.
   LineObservation turned = found.lines[1];
-  turned.alpha_rad = found.lines[0].alpha_rad + DegToRad(20.0);
+  turned.alpha_rad = DegToRad(20.0);
+  turned.rho_m = 2.0 * std::cos(turned.alpha_rad) + 1.0 * std::sin(turned.alpha_rad);
+  FeatureExtractionParams small_angle = params;
+  small_angle.corner_min_angle_deg = 15.0;
+  EXPECT_TRUE(CornerBetween(found.points, noise, small_angle, scan.angle_increment_rad,
+                            found.runs[0], found.runs[1], found.lines[0], turned));
   EXPECT_FALSE(CornerBetween(found.points, noise, params, scan.angle_increment_rad,
                              found.runs[0], found.runs[1], found.lines[0], turned));
 }
