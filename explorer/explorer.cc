@@ -140,68 +140,71 @@ bool Explorer::PlanToGoal(const NavigationMap& map, const Pose2& X_WR, double t_
   return true;
 }
 
-void Explorer::ChooseGoal(const Pose2& X_WR, double t_s) {
-  const NavigationMap map(grid_, params_, X_WR.translation());
+std::vector<Explorer::Candidate> Explorer::ScoreFrontiers(
+    const NavigationMap& map, const std::vector<Eigen::Vector2d>& points, bool* unreachable) {
+  std::vector<Candidate> candidates;
+  for (const Eigen::Vector2d& p : points) {
+    const double gain = InformationGain(grid_, p, params_.gain_radius_m);
+    if (gain < params_.min_gain_m2) continue;
+    bool failed = false;
+    if (Blacklisted(p, &failed)) {
+      *unreachable = *unreachable || failed;
+      continue;
+    }
+    frontier_points_.push_back(p);
+    Eigen::Vector2d best_W = p;
+    const double best = BestViewpoint(map, p, &best_W);
+    if (!std::isfinite(best)) {
+      *unreachable = true;
+      continue;
+    }
+    if (Blacklisted(best_W, &failed)) {
+      *unreachable = *unreachable || failed;
+      continue;
+    }
+    candidates.push_back({p, best_W, params_.gain_weight_per_m2 * gain - best});
+  }
+  std::stable_sort(candidates.begin(), candidates.end(),
+                   [](const Candidate& a, const Candidate& b) { return a.score > b.score; });
+  return candidates;
+}
+
+double Explorer::BestViewpoint(const NavigationMap& map, const Eigen::Vector2d& p_W,
+                               Eigen::Vector2d* viewpoint_W) const {
   const double r = grid_.resolution();
   const int window = static_cast<int>(std::ceil(params_.view_distance_m / r));
+  const Eigen::Vector2i c = grid_.CellOf(p_W);
+  double best = std::numeric_limits<double>::infinity();
+  for (int iy = c.y() - window; iy <= c.y() + window; ++iy) {
+    for (int ix = c.x() - window; ix <= c.x() + window; ++ix) {
+      const double cost = map.CostTo(ix, iy);
+      if (!std::isfinite(cost) || !map.Comfortable(ix, iy)) continue;
+      const Eigen::Vector2d cell = grid_.CellCenter(ix, iy);
+      const double distance = (cell - p_W).norm();
+      if (distance > params_.view_distance_m) continue;
+      if (cost + 2.0 * distance < best) {
+        best = cost + 2.0 * distance;
+        *viewpoint_W = cell;
+      }
+    }
+  }
+  return best;
+}
 
-  struct Candidate {
-    Eigen::Vector2d frontier_W;
-    Eigen::Vector2d goal_W;
-    double score;
-  };
-  // Scores frontier points: gain against the cost of the best reachable cell
-  // within view distance (cost plus twice its distance to the point).
+void Explorer::ChooseGoal(const Pose2& X_WR, double t_s) {
+  const NavigationMap map(grid_, params_, X_WR.translation());
+  // The scan's frontier points first, the grid's when none of those will do.
   // `unreachable` records a frontier with gain that failed or has no
   // reachable cell (a frontier only near reached goals does not count: the
   // robot went there and could not see more).
   bool unreachable = false;
-  auto evaluate = [&](const std::vector<Eigen::Vector2d>& points) {
-    std::vector<Candidate> candidates;
-    for (const Eigen::Vector2d& p : points) {
-      const double gain = InformationGain(grid_, p, params_.gain_radius_m);
-      if (gain < params_.min_gain_m2) continue;
-      bool failed = false;
-      if (Blacklisted(p, &failed)) {
-        unreachable = unreachable || failed;
-        continue;
-      }
-      frontier_points_.push_back(p);
-      const Eigen::Vector2i c = grid_.CellOf(p);
-      double best = std::numeric_limits<double>::infinity();
-      Eigen::Vector2d best_W = p;
-      for (int iy = c.y() - window; iy <= c.y() + window; ++iy) {
-        for (int ix = c.x() - window; ix <= c.x() + window; ++ix) {
-          const double cost = map.CostTo(ix, iy);
-          if (!std::isfinite(cost) || !map.Comfortable(ix, iy)) continue;
-          const Eigen::Vector2d cell = grid_.CellCenter(ix, iy);
-          const double distance = (cell - p).norm();
-          if (distance > params_.view_distance_m) continue;
-          if (cost + 2.0 * distance < best) {
-            best = cost + 2.0 * distance;
-            best_W = cell;
-          }
-        }
-      }
-      if (!std::isfinite(best)) {
-        unreachable = true;
-        continue;
-      }
-      if (Blacklisted(best_W, &failed)) {
-        unreachable = unreachable || failed;
-        continue;
-      }
-      candidates.push_back({p, best_W, params_.gain_weight_per_m2 * gain - best});
-    }
-    std::stable_sort(candidates.begin(), candidates.end(),
-                     [](const Candidate& a, const Candidate& b) { return a.score > b.score; });
-    return candidates;
-  };
-
   frontier_points_.clear();
   ++log_version_;
-  std::vector<Candidate> candidates = evaluate(local_points_);
-  if (candidates.empty()) candidates = evaluate(GlobalFrontierPoints(grid_, params_));
+  std::vector<Candidate> candidates = ScoreFrontiers(map, local_points_, &unreachable);
+  if (candidates.empty()) {
+    candidates = ScoreFrontiers(map, GlobalFrontierPoints(grid_, params_), &unreachable);
+  }
+  // The best candidate that a path reaches; the others are blacklisted.
   for (const Candidate& candidate : candidates) {
     frontier_W_ = candidate.frontier_W;
     goal_W_ = candidate.goal_W;
@@ -222,147 +225,172 @@ void Explorer::ChooseGoal(const Pose2& X_WR, double t_s) {
   tracker_.Clear();
 }
 
-ExplorerOutput Explorer::Step(const Pose2& X_WR, const LaserScan* scan, const Pose2& X_RS,
-                              double t_s, double dt_s) {
-  MJSLAM_CHECK(dt_s > 0.0);
-  ExplorerOutput output;
-  // The map and the scan's frontier points.
-  if (scan != nullptr) {
-    const Pose2 X_WS = X_WR * X_RS;
-    grid_.InsertScan(*scan, X_WS);
-    grid_.MarkRectangleFree(X_WR, params_.body_rear_x_m, params_.body_front_x_m,
-                            params_.body_half_width_m);
-    local_points_ = LocalFrontierPoints(*scan, X_WS, params_);
-    scan_points_W_.clear();
-    for (int i = 0; i < scan->size(); ++i) {
-      if (scan->has_return[i] == 0 || scan->ranges_m[i] >= scan->max_range_m) continue;
-      const double th = X_WS.theta + scan->BeamAngle(i);
-      scan_points_W_.push_back(X_WS.translation() +
-                               scan->ranges_m[i] * Eigen::Vector2d(std::cos(th), std::sin(th)));
-    }
+void Explorer::InsertScan(const Pose2& X_WR, const LaserScan& scan, const Pose2& X_RS) {
+  const Pose2 X_WS = X_WR * X_RS;
+  grid_.InsertScan(scan, X_WS);
+  grid_.MarkRectangleFree(X_WR, params_.body_rear_x_m, params_.body_front_x_m,
+                          params_.body_half_width_m);
+  local_points_ = LocalFrontierPoints(scan, X_WS, params_);
+  scan_points_W_.clear();
+  for (int i = 0; i < scan.size(); ++i) {
+    if (scan.has_return[i] == 0 || scan.ranges_m[i] >= scan.max_range_m) continue;
+    const double th = X_WS.theta + scan.BeamAngle(i);
+    scan_points_W_.push_back(X_WS.translation() +
+                             scan.ranges_m[i] * Eigen::Vector2d(std::cos(th), std::sin(th)));
   }
+}
 
-  Twist2 command;
-  if (phase_ == Phase::kInitialTurn) {
-    // Look around first: the laser covers only the half-plane ahead.
-    if (have_last_theta_) turned_rad_ += std::abs(WrapAngle(X_WR.theta - last_theta_));
-    have_last_theta_ = true;
-    last_theta_ = X_WR.theta;
-    if (turned_rad_ >= DegToRad(params_.initial_turn_deg)) {
-      phase_ = Phase::kExploring;
-    } else {
-      const Twist2 target{0.0, 0.5 * params_.max_angular_speed_radps};
-      command = RateLimit(tracker_.last_command(), target, params_.max_linear_accel_mps2 * dt_s,
-                          params_.max_angular_accel_radps2 * dt_s);
-    }
+Twist2 Explorer::InitialTurn(const Pose2& X_WR, double dt_s) {
+  // Look around first: the laser covers only the half-plane ahead.
+  if (have_last_theta_) turned_rad_ += std::abs(WrapAngle(X_WR.theta - last_theta_));
+  have_last_theta_ = true;
+  last_theta_ = X_WR.theta;
+  if (turned_rad_ >= DegToRad(params_.initial_turn_deg)) {
+    phase_ = Phase::kExploring;
+    return Twist2{};
   }
-  if (phase_ == Phase::kExploring) {
-    // Goal bookkeeping: reached, explored meanwhile, failed.
-    if (has_goal_ && tracker_.done()) DropGoal(true, false);
-    if (has_goal_ && scan != nullptr &&
-        InformationGain(grid_, frontier_W_, params_.gain_radius_m) < params_.min_gain_m2) {
-      DropGoal(false);
-    }
-    if (has_goal_) {
-      const double remaining = RemainingPath(X_WR);
-      if (remaining < best_remaining_m_ - params_.progress_min_m) {
-        best_remaining_m_ = remaining;
-        progress_t_s_ = t_s;
-      }
-      if (t_s - progress_t_s_ > params_.progress_timeout_s ||
-          blocked_total_s_ > params_.blocked_timeout_s) {
-        DropGoal(true);
-      }
-    }
-    if (!has_goal_) {
-      ChooseGoal(X_WR, t_s);
-    } else {
-      // Replan periodically and when the current scan blocks the path ahead.
-      bool blocked_path = false;
-      const Path& path = tracker_.path();
-      const double s0 = path.empty() ? 0.0 : path[tracker_.index()].s_m;
-      for (int i = tracker_.index(); i < static_cast<int>(path.size()) && !blocked_path; ++i) {
-        if (path[i].s_m - s0 < kPathCheckSkipM) continue;
-        if (path[i].s_m - s0 > kPathCheckRangeM) break;
-        for (const Eigen::Vector2d& q : scan_points_W_) {
-          if ((q - path[i].p_W).norm() < params_.body_half_width_m + params_.safety_margin_m) {
-            blocked_path = true;
-            break;
-          }
-        }
-      }
-      if (blocked_path || t_s - last_plan_t_s_ >= params_.replan_period_s) {
-        const NavigationMap map(grid_, params_, X_WR.translation());
-        const double remaining_before = best_remaining_m_;
-        if (PlanToGoal(map, X_WR, t_s)) {
-          // Keep the progress clock: a new plan is not progress.
-          best_remaining_m_ = std::min(remaining_before, RemainingPath(X_WR));
-        } else {
-          DropGoal(true);
-          ChooseGoal(X_WR, t_s);
-        }
-      }
-    }
-    if (!finished_) command = tracker_.Command(X_WR, dt_s);
-  }
+  const Twist2 target{0.0, 0.5 * params_.max_angular_speed_radps};
+  return RateLimit(tracker_.last_command(), target, params_.max_linear_accel_mps2 * dt_s,
+                   params_.max_angular_accel_radps2 * dt_s);
+}
 
-  if (finished_) {
-    output.finished = true;
-    output.finish_reason = finish_reason_;
-    output.command = Twist2{};
-    return output;
+void Explorer::CheckGoal(const Pose2& X_WR, bool new_scan, double t_s) {
+  // Reached, explored meanwhile, failed (no progress, or blocked too long).
+  if (has_goal_ && tracker_.done()) DropGoal(true, false);
+  if (has_goal_ && new_scan &&
+      InformationGain(grid_, frontier_W_, params_.gain_radius_m) < params_.min_gain_m2) {
+    DropGoal(false);
   }
-  // Safety layer last: it may brake harder than the acceleration limits.
+  if (has_goal_) {
+    const double remaining = RemainingPath(X_WR);
+    if (remaining < best_remaining_m_ - params_.progress_min_m) {
+      best_remaining_m_ = remaining;
+      progress_t_s_ = t_s;
+    }
+    if (t_s - progress_t_s_ > params_.progress_timeout_s ||
+        blocked_total_s_ > params_.blocked_timeout_s) {
+      DropGoal(true);
+    }
+  }
+}
+
+bool Explorer::ScanBlocksPath() const {
+  const Path& path = tracker_.path();
+  const double s0 = path.empty() ? 0.0 : path[tracker_.index()].s_m;
+  for (int i = tracker_.index(); i < static_cast<int>(path.size()); ++i) {
+    if (path[i].s_m - s0 < kPathCheckSkipM) continue;
+    if (path[i].s_m - s0 > kPathCheckRangeM) break;
+    for (const Eigen::Vector2d& q : scan_points_W_) {
+      if ((q - path[i].p_W).norm() < params_.body_half_width_m + params_.safety_margin_m) {
+        return true;
+      }
+    }
+  }
+  return false;
+}
+
+void Explorer::Replan(const Pose2& X_WR, double t_s) {
+  const NavigationMap map(grid_, params_, X_WR.translation());
+  const double remaining_before = best_remaining_m_;
+  if (PlanToGoal(map, X_WR, t_s)) {
+    // Keep the progress clock: a new plan is not progress.
+    best_remaining_m_ = std::min(remaining_before, RemainingPath(X_WR));
+  } else {
+    DropGoal(true);
+    ChooseGoal(X_WR, t_s);
+  }
+}
+
+Twist2 Explorer::Recover(const Twist2& command, const Pose2& X_WR,
+                         const std::vector<Eigen::Vector2d>& obstacles, double dt_s) {
+  // Back up straight while it is safe (the occupied cells of the grid cover
+  // the space behind the laser); when it is not, drive forward straight, then
+  // turn in place either way, so that a robot wedged next to a door jamb
+  // (where neither backing up nor the turn the path wants is safe) gets free
+  // instead of failing every goal in turn. The motion chosen at the start of
+  // a recovery is kept while it stays safe.
+  const Twist2 escapes[] = {{-kRecoverySpeedMps, 0.0},
+                            {kRecoverySpeedMps, 0.0},
+                            {0.0, kRecoveryTurnRadps},
+                            {0.0, -kRecoveryTurnRadps}};
+  const int n = static_cast<int>(std::size(escapes));
+  for (int k = 0; k < n; ++k) {
+    // The current escape first, then the others in order.
+    const int i = recovery_escape_ >= 0 ? (recovery_escape_ + k) % n : k;
+    if (recovery_escape_ >= 0 && k > 0) break;
+    bool escape_limited = false;
+    const Twist2 safe = SafetyFilter(escapes[i], X_WR, obstacles, params_, a_m_, dt_s,
+                                     &escape_limited);
+    if (!escape_limited) {
+      recovery_escape_ = i;
+      return safe;
+    }
+  }
+  // No escape is safe: the recovery ends.
+  recovery_until_s_ = -1.0;
+  recovery_escape_ = -1;
+  return command;
+}
+
+ExplorerOutput Explorer::SafeOutput(const Twist2& wanted, const Pose2& X_WR, double t_s,
+                                    double dt_s) {
   const std::vector<Eigen::Vector2d> obstacles = NearbyObstacles(X_WR);
-  bool limited = false;
+  // A back-up recovery after the robot has been held still long enough.
+  Twist2 command = wanted;
   if (blocked_s_ >= kRecoveryAfterS && recovery_until_s_ < t_s) {
     recovery_until_s_ = t_s + kRecoveryS;
     blocked_s_ = 0.0;
   }
   if (recovery_until_s_ >= t_s) {
-    // Recovery: back up straight while it is safe (the occupied cells of the
-    // grid cover the space behind the laser); when it is not, drive forward
-    // straight, then turn in place either way, so that a robot wedged next
-    // to a door jamb (where neither backing up nor the turn the path wants
-    // is safe) gets free instead of failing every goal in turn. The motion
-    // chosen at the start of a recovery is kept while it stays safe.
-    const Twist2 escapes[] = {{-kRecoverySpeedMps, 0.0},
-                              {kRecoverySpeedMps, 0.0},
-                              {0.0, kRecoveryTurnRadps},
-                              {0.0, -kRecoveryTurnRadps}};
-    bool found = false;
-    const int n = static_cast<int>(std::size(escapes));
-    for (int k = 0; k < n && !found; ++k) {
-      // The current escape first, then the others in order.
-      const int i = recovery_escape_ >= 0 ? (recovery_escape_ + k) % n : k;
-      if (recovery_escape_ >= 0 && k > 0) break;
-      bool escape_limited = false;
-      const Twist2 safe = SafetyFilter(escapes[i], X_WR, obstacles, params_, a_m_, dt_s,
-                                       &escape_limited);
-      if (!escape_limited) {
-        command = safe;
-        recovery_escape_ = i;
-        found = true;
-      }
-    }
-    if (!found) {
-      recovery_until_s_ = -1.0;
-      recovery_escape_ = -1;
-    }
+    command = Recover(command, X_WR, obstacles, dt_s);
   } else {
     recovery_escape_ = -1;
   }
+  // The safety filter, and the clocks of how long it has held the robot.
+  bool limited = false;
   command = SafetyFilter(command, X_WR, obstacles, params_, a_m_, dt_s, &limited);
   tracker_.set_last_command(command);
-  output.safety_active = limited;
   if (limited && std::abs(command.v_mps) < 1e-3 && std::abs(command.w_radps) < 1e-3) {
     blocked_s_ += dt_s;
     blocked_total_s_ += dt_s;
   } else {
     blocked_s_ = 0.0;
   }
+  ExplorerOutput output;
+  output.safety_active = limited;
   output.command = command;
   return output;
+}
+
+ExplorerOutput Explorer::Step(const Pose2& X_WR, const LaserScan* scan, const Pose2& X_RS,
+                              double t_s, double dt_s) {
+  MJSLAM_CHECK(dt_s > 0.0);
+  // The map and the scan's frontier points.
+  if (scan != nullptr) InsertScan(X_WR, *scan, X_RS);
+
+  // The command the phase wants: the initial turn, or tracking the path to
+  // the goal (kept, replaced or replanned first).
+  Twist2 command;
+  if (phase_ == Phase::kInitialTurn) command = InitialTurn(X_WR, dt_s);
+  if (phase_ == Phase::kExploring) {
+    CheckGoal(X_WR, scan != nullptr, t_s);
+    if (!has_goal_) {
+      ChooseGoal(X_WR, t_s);
+    } else if (ScanBlocksPath() || t_s - last_plan_t_s_ >= params_.replan_period_s) {
+      Replan(X_WR, t_s);
+    }
+    if (!finished_) command = tracker_.Command(X_WR, dt_s);
+  }
+
+  if (finished_) {
+    ExplorerOutput output;
+    output.finished = true;
+    output.finish_reason = finish_reason_;
+    output.command = Twist2{};
+    return output;
+  }
+  // Safety layer last: it may brake harder than the acceleration limits.
+  return SafeOutput(command, X_WR, t_s, dt_s);
 }
 
 }  // namespace mjslam::explorer

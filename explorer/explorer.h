@@ -97,8 +97,53 @@ class Explorer {
  private:
   enum class Phase { kInitialTurn, kExploring, kFinished };
 
+  // A frontier point with gain, the cell h would view it from, and its score
+  // (gain_weight_per_m2 * gain - cost of that cell).
+  struct Candidate {
+    Eigen::Vector2d frontier_W;
+    Eigen::Vector2d goal_W;
+    double score;
+  };
+
+  // The steps of Step(), in order.
+  // Updates the grid at X_WS = X_WR X_RS, the scan's local frontier points
+  // and its echoes in W.
+  void InsertScan(const Pose2& X_WR, const LaserScan& scan, const Pose2& X_RS);
+  // The command of the initial turn in place; ends the turn (and returns a
+  // zero command) once the robot has turned `initial_turn_deg`.
+  Twist2 InitialTurn(const Pose2& X_WR, double dt_s);
+  // Drops the goal when it is reached, explored meanwhile (`new_scan` only),
+  // or failed (no progress within progress_timeout_s, blocked for
+  // blocked_timeout_s); tracks the progress along the path.
+  void CheckGoal(const Pose2& X_WR, bool new_scan, double t_s);
+  // Whether an echo of the last scan lies on the path ahead (between
+  // kPathCheckSkipM and kPathCheckRangeM along it) within the body's half
+  // width plus the safety margin.
+  bool ScanBlocksPath() const;
+  // Plans the current goal again (keeping the progress clock); when that
+  // fails, drops it and chooses another.
+  void Replan(const Pose2& X_WR, double t_s);
+  // The safety layer: a back-up recovery when the robot has been held still,
+  // the SafetyFilter, and the blocked clocks.
+  ExplorerOutput SafeOutput(const Twist2& wanted, const Pose2& X_WR, double t_s, double dt_s);
+  // One step of a recovery: the first safe escape motion (the current one
+  // only, once chosen), or `command` when none is safe (the recovery ends).
+  Twist2 Recover(const Twist2& command, const Pose2& X_WR,
+                 const std::vector<Eigen::Vector2d>& obstacles, double dt_s);
+
   // Picks a goal and plans a path to it; finishes when there is none.
   void ChooseGoal(const Pose2& X_WR, double t_s);
+  // The frontier points among `points` with gain that are not blacklisted
+  // (appended to frontier_points_), scored, best first; sets `unreachable`
+  // when one with gain failed before or has no reachable viewpoint.
+  std::vector<Candidate> ScoreFrontiers(const NavigationMap& map,
+                                        const std::vector<Eigen::Vector2d>& points,
+                                        bool* unreachable);
+  // The least cost, path cost plus twice the distance, of a comfortable
+  // reachable cell within view_distance_m of `p_W`, and that cell's centre in
+  // `viewpoint_W` (untouched when there is none: the cost is infinite).
+  double BestViewpoint(const NavigationMap& map, const Eigen::Vector2d& p_W,
+                       Eigen::Vector2d* viewpoint_W) const;
   // Plans a path to the current goal; false when there is none.
   bool PlanToGoal(const NavigationMap& map, const Pose2& X_WR, double t_s);
   // Drops the current goal; blacklists it when `blacklist`, as failed when

@@ -169,15 +169,13 @@ void EkfSlam::GrowSegment(int k, const Observation& observation) {
                                    X_WS * observation.p_SB);
 }
 
-StepReport EkfSlam::Step(const SensorRecord& record, const ScanFeatures* features) {
-  // Everything is checked before anything changes.
+MotionInput EkfSlam::CheckedMotionInput(const SensorRecord& record) const {
   if (!std::isfinite(record.dt_s) || record.dt_s < 0.0) {
     throw SlamInputError("EkfSlam::Step: record.dt_s: expected a finite value >= 0 (got " +
                          ValueText(record.dt_s) + ")");
   }
-  const bool use_odometry = params_.input == "odometry";
   MotionInput input;
-  if (use_odometry) {
+  if (params_.input == "odometry") {
     if (!IsFinite(record.X_OR)) {
       throw SlamInputError("EkfSlam::Step: record.X_OR: expected a finite pose (got " +
                            PoseText(record.X_OR) + ")");
@@ -194,16 +192,92 @@ StepReport EkfSlam::Step(const SensorRecord& record, const ScanFeatures* feature
   const double slip_std = params_.lateral_slip_std_m_per_rad * std::abs(input.increment.y());
   input.lateral_variance_m2 = slip_std * slip_std;
   if (record.dt_s > 0.0) input.skid_per_m_rad = params_.lateral_skid_s / record.dt_s;
-  std::vector<Observation> observations;
-  if (features != nullptr) observations = CollectObservations(*features);
+  return input;
+}
 
-  // Prediction, Eqs. (1)-(2) with (6).
-  if (use_odometry) {
+void EkfSlam::Predict(const SensorRecord& record, const MotionInput& input) {
+  if (params_.input == "odometry") {
     X_OR_previous_ = record.X_OR;
     has_odometry_ = true;
   }
   previous_command_ = record.command;
   state_.Predict(input, params_.control_point_offset_m);
+}
+
+std::vector<MatchedObservation> EkfSlam::SelectMatches(
+    const Association& association, const std::vector<Observation>& observations,
+    const ScanFeatures& features, StepReport* report, std::vector<int>* matched_observation) const {
+  // Observations are the lines, then the corners (CollectObservations).
+  const int num_lines = static_cast<int>(features.lines.size());
+  auto line_matched = [&](int line) {
+    return line >= 0 && line < num_lines &&
+           association.outcome[line] == AssociationOutcome::kMatched;
+  };
+  std::vector<MatchedObservation> matched;
+  for (int i = 0; i < report->num_observed; ++i) {
+    if (association.outcome[i] == AssociationOutcome::kMatched) {
+      if (i >= num_lines && !params_.correct_corners_of_matched_lines) {
+        // The corner repeats what its two lines say when both correct too.
+        const CornerObservation& corner = features.corners[i - num_lines];
+        if (line_matched(corner.line_a) && line_matched(corner.line_b)) {
+          ++report->num_redundant_corners;
+          continue;
+        }
+      }
+      matched.push_back({association.feature[i], observations[i].z, observations[i].R});
+      matched_observation->push_back(i);
+    } else if (association.outcome[i] == AssociationOutcome::kNew) {
+      ++report->num_new;
+    } else {
+      ++report->num_ambiguous;
+    }
+  }
+  report->num_matched = static_cast<int>(matched.size()) + report->num_redundant_corners;
+  return matched;
+}
+
+void EkfSlam::AddNewFeatures(const Association& association,
+                             const std::vector<Observation>& observations,
+                             const ScanFeatures& features, StepReport* report) {
+  // The lines come first, so a new corner can be placed where its lines are.
+  const int num_lines = static_cast<int>(features.lines.size());
+  std::vector<int> line_feature(num_lines, -1);
+  for (int i = 0; i < num_lines; ++i) {
+    if (association.outcome[i] == AssociationOutcome::kMatched) line_feature[i] = association.feature[i];
+  }
+  for (int i = 0; i < report->num_observed; ++i) {
+    if (association.outcome[i] != AssociationOutcome::kNew) continue;
+    const Observation& observation = observations[i];
+    int k = -1;
+    if (i >= num_lines && params_.corners_from_map_lines) {
+      const CornerObservation& corner = features.corners[i - num_lines];
+      auto map_line = [&](int line) { return line >= 0 && line < num_lines ? line_feature[line] : -1; };
+      const int a = map_line(corner.line_a);
+      const int b = map_line(corner.line_b);
+      if (a >= 0 && b >= 0 && a != b) {
+        k = state_.AddLineIntersection(a, b);
+        ++report->num_corners_from_lines;
+      }
+    }
+    if (k < 0) k = state_.AddFeature(observation.type, observation.z, observation.R);
+    if (i < num_lines) line_feature[i] = k;
+    info_.push_back({next_id_++, LineSegment{}});
+    if (observation.type == FeatureType::kLine) {
+      const Pose2 X_WS = X_WR() * state_.X_RS();
+      info_[k].segment = SegmentFromPoints(state_.feature(k), X_WS * observation.p_SA,
+                                           X_WS * observation.p_SB);
+    }
+  }
+}
+
+StepReport EkfSlam::Step(const SensorRecord& record, const ScanFeatures* features) {
+  // Everything is checked before anything changes.
+  const MotionInput input = CheckedMotionInput(record);
+  std::vector<Observation> observations;
+  if (features != nullptr) observations = CollectObservations(*features);
+
+  // Prediction, Eqs. (1)-(2) with (6).
+  Predict(record, input);
 
   StepReport report;
   if (features == nullptr) {
@@ -212,36 +286,12 @@ StepReport EkfSlam::Step(const SensorRecord& record, const ScanFeatures* feature
   }
   report.num_observed = static_cast<int>(observations.size());
 
-  // Data association against the predicted map.
+  // Data association against the predicted map, and the matches that correct.
   const Association association = AssociateNearestNeighbour(
       MahalanobisDistances(observations), gate_, new_feature_threshold_);
-  // Observations are the lines, then the corners (CollectObservations).
-  const int num_lines = static_cast<int>(features->lines.size());
-  auto line_matched = [&](int line) {
-    return line >= 0 && line < num_lines &&
-           association.outcome[line] == AssociationOutcome::kMatched;
-  };
-  std::vector<MatchedObservation> matched;
   std::vector<int> matched_observation;
-  for (int i = 0; i < report.num_observed; ++i) {
-    if (association.outcome[i] == AssociationOutcome::kMatched) {
-      if (i >= num_lines && !params_.correct_corners_of_matched_lines) {
-        // The corner repeats what its two lines say when both correct too.
-        const CornerObservation& corner = features->corners[i - num_lines];
-        if (line_matched(corner.line_a) && line_matched(corner.line_b)) {
-          ++report.num_redundant_corners;
-          continue;
-        }
-      }
-      matched.push_back({association.feature[i], observations[i].z, observations[i].R});
-      matched_observation.push_back(i);
-    } else if (association.outcome[i] == AssociationOutcome::kNew) {
-      ++report.num_new;
-    } else {
-      ++report.num_ambiguous;
-    }
-  }
-  report.num_matched = static_cast<int>(matched.size()) + report.num_redundant_corners;
+  const std::vector<MatchedObservation> matched =
+      SelectMatches(association, observations, *features, &report, &matched_observation);
 
   // Correction: Algorithm 1 or 2.
   if (mode_ == CorrectionMode::kClassical) {
@@ -258,35 +308,8 @@ StepReport EkfSlam::Step(const SensorRecord& record, const ScanFeatures* feature
     if (observation.type == FeatureType::kLine) GrowSegment(matched[m].feature, observation);
   }
 
-  // New features from the corrected pose (inverse observation models). The
-  // lines come first, so a new corner can be placed where its lines are.
-  std::vector<int> line_feature(num_lines, -1);
-  for (int i = 0; i < num_lines; ++i) {
-    if (association.outcome[i] == AssociationOutcome::kMatched) line_feature[i] = association.feature[i];
-  }
-  for (int i = 0; i < report.num_observed; ++i) {
-    if (association.outcome[i] != AssociationOutcome::kNew) continue;
-    const Observation& observation = observations[i];
-    int k = -1;
-    if (i >= num_lines && params_.corners_from_map_lines) {
-      const CornerObservation& corner = features->corners[i - num_lines];
-      auto map_line = [&](int line) { return line >= 0 && line < num_lines ? line_feature[line] : -1; };
-      const int a = map_line(corner.line_a);
-      const int b = map_line(corner.line_b);
-      if (a >= 0 && b >= 0 && a != b) {
-        k = state_.AddLineIntersection(a, b);
-        ++report.num_corners_from_lines;
-      }
-    }
-    if (k < 0) k = state_.AddFeature(observation.type, observation.z, observation.R);
-    if (i < num_lines) line_feature[i] = k;
-    info_.push_back({next_id_++, LineSegment{}});
-    if (observation.type == FeatureType::kLine) {
-      const Pose2 X_WS = X_WR() * state_.X_RS();
-      info_[k].segment = SegmentFromPoints(state_.feature(k), X_WS * observation.p_SA,
-                                           X_WS * observation.p_SB);
-    }
-  }
+  // New features from the corrected pose (inverse observation models).
+  AddNewFeatures(association, observations, *features, &report);
   report.num_features = state_.num_features();
   return report;
 }

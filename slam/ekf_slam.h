@@ -9,6 +9,8 @@
 #include "common/pose2.h"
 #include "common/records.h"
 #include "slam/corrections.h"
+#include "slam/data_association.h"
+#include "slam/motion_model.h"
 #include "slam/observations.h"
 #include "slam/secondary_map.h"
 #include "slam/slam_params.h"
@@ -145,6 +147,30 @@ class EkfSlam {
   // Extends line k's seen segment with an observation's endpoints, seen from
   // the current pose estimate.
   void GrowSegment(int k, const Observation& observation);
+
+  // The steps of Step(), in order.
+  // The motion input of `record` (odometry increment or command, with the
+  // slip and skid terms); throws SlamInputError on a bad record. Changes
+  // nothing.
+  MotionInput CheckedMotionInput(const SensorRecord& record) const;
+  // Predicts with `input` and keeps the record's odometry pose and command
+  // as the reference of the next step.
+  void Predict(const SensorRecord& record, const MotionInput& input);
+  // The matched observations that correct, with their indices into
+  // `observations` in `matched_observation`: all matches except corners
+  // whose two lines matched too (unless correct_corners_of_matched_lines).
+  // Counts matched, redundant, new and ambiguous ones in `report`
+  // (num_observed must be set).
+  std::vector<MatchedObservation> SelectMatches(const Association& association,
+                                                const std::vector<Observation>& observations,
+                                                const ScanFeatures& features, StepReport* report,
+                                                std::vector<int>* matched_observation) const;
+  // Adds the new observations to the map from the current pose, lines
+  // first; a new corner of two map lines is their intersection when
+  // corners_from_map_lines. Counts those corners in `report`.
+  void AddNewFeatures(const Association& association,
+                      const std::vector<Observation>& observations, const ScanFeatures& features,
+                      StepReport* report);
 
   EkfParams params_;
   CorrectionMode mode_;

@@ -177,18 +177,10 @@ int SlamState::Append(FeatureType type, const Eigen::Vector2d& f) {
   return num_features() - 1;
 }
 
-void SlamState::Update(int k, const Eigen::Vector2d& z, const Eigen::Matrix2d& R) {
-  MJSLAM_CHECK(k >= 0 && k < num_features());
-  const Eigen::Vector3d pose_WR = pose();
-  Eigen::Matrix<double, 2, 3> H_pose;
-  Eigen::Matrix2d H_feature;
-  Eigen::Vector2d h = PredictObservation(types_[k], pose_WR, feature(k), X_RS_, &H_pose,
-                                         &H_feature);
-  if (types_[k] == FeatureType::kLine) AlignLineToObservation(z, &h, &H_pose, &H_feature);
-  const Eigen::Vector2d nu = Innovation(z, h);
-
+Eigen::Vector2d SlamState::WhitenedGain(int j, const Eigen::Matrix<double, 2, 3>& H_pose,
+                                        const Eigen::Matrix2d& H_feature,
+                                        const Eigen::Matrix2d& R, const Eigen::Vector2d& nu) {
   const int n = n_;
-  const int j = FeatureIndex(k);
   const Eigen::Index stride = P_.outerStride();
   const double* p0 = P_.data();
   const double* p1 = p0 + stride;
@@ -234,6 +226,16 @@ void SlamState::Update(int k, const Eigen::Vector2d& z, const Eigen::Matrix2d& R
   }
   const double w0 = nu.x() * inv_l11;
   const double w1 = (nu.y() - l21 * w0) * inv_l22;
+  return Eigen::Vector2d(w0, w1);
+}
+
+void SlamState::ApplyGain(const Eigen::Vector2d& w) {
+  const int n = n_;
+  const Eigen::Index stride = P_.outerStride();
+  const double* u0 = scratch_.data();
+  const double* u1 = u0 + scratch_.outerStride();
+  const double w0 = w.x();
+  const double w1 = w.y();
 
   // Mean: xi <- xi + K nu.
   double* x = x_.data();
@@ -264,14 +266,33 @@ void SlamState::Update(int k, const Eigen::Vector2d& z, const Eigen::Matrix2d& R
     const double a1 = u1[c];
     for (int r = 0; r < n; ++r) col[r] -= std::fma(u0[r], a0, u1[r] * a1);
   }
+}
 
-  // Angles back into (-pi, pi].
+void SlamState::WrapAngles() {
+  double* x = x_.data();
   x_.z() = WrapAngleFast(x_.z());
   for (int f = 0; f < num_features(); ++f) {
     if (types_[f] != FeatureType::kLine) continue;
     double& al = x[FeatureIndex(f) + 1];
     al = WrapAngleFast(al);
   }
+}
+
+void SlamState::Update(int k, const Eigen::Vector2d& z, const Eigen::Matrix2d& R) {
+  MJSLAM_CHECK(k >= 0 && k < num_features());
+  // The prediction, its Jacobians and the innovation.
+  const Eigen::Vector3d pose_WR = pose();
+  Eigen::Matrix<double, 2, 3> H_pose;
+  Eigen::Matrix2d H_feature;
+  Eigen::Vector2d h = PredictObservation(types_[k], pose_WR, feature(k), X_RS_, &H_pose,
+                                         &H_feature);
+  if (types_[k] == FeatureType::kLine) AlignLineToObservation(z, &h, &H_pose, &H_feature);
+  const Eigen::Vector2d nu = Innovation(z, h);
+
+  // The correction, then the angles back into (-pi, pi].
+  const Eigen::Vector2d w = WhitenedGain(FeatureIndex(k), H_pose, H_feature, R, nu);
+  ApplyGain(w);
+  WrapAngles();
 }
 
 }  // namespace mjslam::slam

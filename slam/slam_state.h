@@ -131,6 +131,17 @@ class SlamState {
   // Ends an augmentation whose P rows and columns are written: appends the
   // mean f of a feature of `type` and returns its index.
   int Append(FeatureType type, const Eigen::Vector2d& f);
+  // The steps of Update, in order. WhitenedGain computes V = P H^T L^-T
+  // into scratch_ (H = [H_pose at the pose, H_feature at state index j]),
+  // with S = H P H^T + R = L L^T, and returns L^-1 nu, so that K nu = V L^-1 nu.
+  // Precondition (checked): S positive definite.
+  Eigen::Vector2d WhitenedGain(int j, const Eigen::Matrix<double, 2, 3>& H_pose,
+                               const Eigen::Matrix2d& H_feature, const Eigen::Matrix2d& R,
+                               const Eigen::Vector2d& nu);
+  // xi <- xi + V w and P <- P - V V^T with V in scratch_ (from WhitenedGain).
+  void ApplyGain(const Eigen::Vector2d& w);
+  // Wraps the heading and every line's alpha into (-pi, pi].
+  void WrapAngles();
 
   Pose2 X_RS_;
   int n_ = 3;
