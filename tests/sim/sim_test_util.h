@@ -1,8 +1,8 @@
 #pragma once
 
 // Helpers shared by the sim tests: inline MJCF worlds written to temporary
-// files, the robot model's path, and a fixture that turns MuJoCo errors and
-// warnings into test failures.
+// files, the robot model's path, and a fixture that installs the MuJoCo
+// error and warning handlers (sim/mujoco_errors.h) and cleans up.
 
 #include <filesystem>
 #include <fstream>
@@ -11,9 +11,8 @@
 #include <unistd.h>
 
 #include <gtest/gtest.h>
-#include <mujoco/mujoco.h>
 
-#include "sim/simulator.h"
+#include "sim/mujoco_errors.h"
 
 namespace mjslam::sim::testing {
 
@@ -53,28 +52,15 @@ inline std::string WorldXml(const std::string& body,
          start + "\n    " + body + "\n  </worldbody>\n</mujoco>\n";
 }
 
-inline void FailOnMujocoError(const char* message) {
-  ADD_FAILURE() << "MuJoCo error: " << message;
-  throw SimError(std::string("MuJoCo error: ") + message);  // must not return to MuJoCo
-}
-
-inline void FailOnMujocoWarning(const char* message) {
-  ADD_FAILURE() << "MuJoCo warning: " << message;
-  throw SimError(std::string("MuJoCo warning: ") + message);
-}
-
-/// Installs MuJoCo error and warning hooks that fail the running test (the
-/// Simulator keeps hooks that are already installed), and removes the test's
-/// temporary files afterwards.
+/// Installs the MuJoCo error and warning handlers before each test (so a
+/// MuJoCo error or warning in any trapped call becomes a SimError, which
+/// fails a test that does not expect it, and one outside a trapped call
+/// aborts the test program), and removes the test's temporary files
+/// afterwards.
 class MujocoTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    mju_user_error = &FailOnMujocoError;
-    mju_user_warning = &FailOnMujocoWarning;
-  }
+  void SetUp() override { InstallMujocoErrorHandlers(); }
   void TearDown() override {
-    mju_user_error = nullptr;
-    mju_user_warning = nullptr;
     std::error_code ignored;
     std::filesystem::remove_all(TempDir(), ignored);
   }
