@@ -59,7 +59,7 @@ const char* TrappedWarning();
 /// end). `call`'s body must only call MuJoCo's C functions and touch plain
 /// data (numbers, raw pointers, arrays): no object with a non-trivial
 /// destructor may be created inside it, since an error skips its frame. After
-/// an error, the mjData (and for some calls the mjModel) that the call worked
+/// an error, the MuJoCo data (and for some calls the model) that the call worked
 /// on is in an unspecified state and must be discarded.
 template <typename Call>
 std::string TrapMujocoErrors(Call& call) {

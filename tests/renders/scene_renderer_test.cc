@@ -52,7 +52,7 @@ class SceneRendererTest : public ::testing::Test {
     world_ = new std::string(WriteTinyWorld());
     renderer_ = new SceneRenderer(
         sim::Scene(*world_, std::string(MJSLAM_SOURCE_DIR) + "/models/pioneer3dx.xml"),
-        sim::SimParams{}, sim::RobotParams{}, 160, 120);
+        sim::SimParams{}, sim::RobotParams{}, 400, 160);
   }
   static void TearDownTestSuite() {
     delete renderer_;
@@ -76,8 +76,8 @@ TEST_F(SceneRendererTest, DrawsWallFloorRobotAndLayersInTheirColours) {
   frame.filters = {selective};
   frame.laser_hits = {{-2.0, 1.0}};
   const Image image = renderer_->Render(frame);
-  ASSERT_EQ(image.width, 160);
-  ASSERT_EQ(image.height, 120);
+  ASSERT_EQ(image.width, 400);
+  ASSERT_EQ(image.height, 160);
 
   // The wall is drawn dark grey, the floor light grey, whatever the world says.
   ExpectColor(ColorAt(*renderer_, image, {2.0, 1.0}), {0.30f, 0.30f, 0.30f}, "wall");
@@ -120,20 +120,18 @@ bool AnyPixelOfColour(const Image& image, int x0, int x1, const Rgb& want) {
   return false;
 }
 
-TEST(SceneRendererLegendTest, ALegendStripListsTheLayersInTheirColours) {
-  const std::string world = WriteTinyWorld();
-  SceneRenderer renderer(sim::Scene(world, std::string(MJSLAM_SOURCE_DIR) + "/models/pioneer3dx.xml"),
-                         sim::SimParams{}, sim::RobotParams{}, 400, 200);
+TEST_F(SceneRendererTest, ALegendStripListsTheLayersInTheirColours) {
   SceneFrame frame;
   frame.X_WR_true = Pose2(-1.0, 0.0, 0.0);
   FilterLayer selective;
   selective.name = "selective";
   selective.color = colors::kSelective;
   frame.filters = {selective};
-  const Image image = renderer.Render(frame);
-  // Right of the wall there is only floor, then the legend strip with a
-  // swatch per layer (nothing else in this frame is blue or green).
-  const int strip = static_cast<int>(renderer.PixelOf({2.2, 0.0}).x());
+  const Image image = renderer_->Render(frame);
+  // Right of the wall there is only floor, then the legend strip (images at
+  // least 400 pixels wide) with a swatch per layer; nothing else in this
+  // frame is blue or green.
+  const int strip = static_cast<int>(renderer_->PixelOf({2.2, 0.0}).x());
   ASSERT_LT(strip, 400 - 100);
   EXPECT_TRUE(AnyPixelOfColour(image, strip, 400, colors::kSelective));
   EXPECT_TRUE(AnyPixelOfColour(image, strip, 400, colors::kLaserHits));
