@@ -96,8 +96,8 @@ class Simulator {
   /// `beam_angle_offsets_rad` (empty, or one per beam): beam i is really cast
   /// at its bearing plus offset i (angular jitter, see LaserNoise) but the
   /// scan reports the nominal bearings. Throws ParamError for invalid
-  /// `laser`, SimError for a wrong number of offsets. Cast only at the scan
-  /// rate: it costs num_beams ray casts.
+  /// `laser`, SimError for a wrong number of offsets or a MuJoCo error. Cast
+  /// only at the scan rate: it costs num_beams ray casts.
   LaserScan CastLaser(const LaserParams& laser,
                       const std::vector<double>& beam_angle_offsets_rad = {}) const;
 

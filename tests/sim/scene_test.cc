@@ -18,6 +18,7 @@
 namespace mjslam::sim {
 namespace {
 
+using testing::Contains;
 using testing::MujocoTest;
 using testing::RobotModelPath;
 using testing::WorldXml;
@@ -31,10 +32,6 @@ std::string SceneError(const std::string& world, const std::string& robot_model 
     return error.what();
   }
   return "";
-}
-
-bool Contains(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
 }
 
 // The latest simulated time MuJoCo's control callback has seen, in any
@@ -121,14 +118,10 @@ TEST_F(SceneTest, IsBuiltWithoutAPhysicsStep) {
   mjcb_control = &RecordControlTime;
   // Worlds the physics rejects load as scenes: one without a floor (the
   // robot would fall) and one whose start is inside a wall.
-  const Scene no_floor(
-      WriteTempFile("no_floor.xml",
-                    "<mujoco><worldbody><site name=\"start\"/></worldbody></mujoco>"),
-      RobotModelPath());
-  const std::string in_wall = WriteTempFile(
-      "start_in_wall.xml",
-      WorldXml("<geom name=\"wall\" type=\"box\" size=\"0.1 2 0.5\" pos=\"-0.2 0 0.5\"/>"));
-  const Scene scene(in_wall, RobotModelPath());
+  const Scene no_floor(WriteTempFile("no_floor.xml", testing::NoFloorWorldXml()),
+                       RobotModelPath());
+  const Scene scene(WriteTempFile("start_in_wall.xml", testing::StartInWallWorldXml()),
+                    RobotModelPath());
   EXPECT_EQ(latest_control_time_s, 0.0);
   EXPECT_EQ(scene.Obstacles().size(), 1u);
   // With physics on a scene, simulated time passes (the robot settles).

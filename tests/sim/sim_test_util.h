@@ -52,6 +52,23 @@ inline std::string WorldXml(const std::string& body,
          start + "\n    " + body + "\n  </worldbody>\n</mujoco>\n";
 }
 
+/// A world the scene accepts but the physics rejects: no floor (the robot
+/// does not come to rest).
+inline std::string NoFloorWorldXml() {
+  return "<mujoco><worldbody><site name=\"start\"/></worldbody></mujoco>";
+}
+
+/// A world the scene accepts but the physics rejects: the start pose puts
+/// the robot's rear into the geom 'wall'.
+inline std::string StartInWallWorldXml() {
+  return WorldXml("<geom name=\"wall\" type=\"box\" size=\"0.1 2 0.5\" pos=\"-0.2 0 0.5\"/>");
+}
+
+/// Whether `text` contains `part`.
+inline bool Contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
 /// Installs the MuJoCo error and warning handlers before each test (so a
 /// MuJoCo error or warning in any trapped call becomes a SimError, which
 /// fails a test that does not expect it, and one outside a trapped call

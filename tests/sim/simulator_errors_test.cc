@@ -13,6 +13,7 @@
 namespace mjslam::sim {
 namespace {
 
+using testing::Contains;
 using testing::MujocoTest;
 using testing::RobotModelPath;
 using testing::WorldXml;
@@ -29,10 +30,6 @@ std::string LoadError(const std::string& world, const SimParams& sim = {},
     return error.what();
   }
   return "";
-}
-
-bool Contains(const std::string& text, const std::string& part) {
-  return text.find(part) != std::string::npos;
 }
 
 // See MujocoErrorInsideAPhysicsCall... below. With MuJoCo 2.2.2, the
@@ -99,18 +96,14 @@ TEST_F(SimulatorErrorsTest, UnstableWheelGainIsRejected) {
 }
 
 TEST_F(SimulatorErrorsTest, StartPoseInCollision) {
-  const std::string world = WriteTempFile(
-      "collision_world.xml",
-      WorldXml("<geom name=\"wall\" type=\"box\" size=\"0.1 2 0.5\" pos=\"-0.2 0 0.5\"/>"));
-  const std::string message = LoadError(world);
+  const std::string message =
+      LoadError(WriteTempFile("collision_world.xml", testing::StartInWallWorldXml()));
   EXPECT_TRUE(Contains(message, "in collision")) << message;
   EXPECT_TRUE(Contains(message, "'wall'")) << message;
 }
 
 TEST_F(SimulatorErrorsTest, WorldWithoutFloor) {
-  const std::string world = WriteTempFile(
-      "no_floor.xml", "<mujoco><worldbody><site name=\"start\"/></worldbody></mujoco>");
-  const std::string message = LoadError(world);
+  const std::string message = LoadError(WriteTempFile("no_floor.xml", testing::NoFloorWorldXml()));
   EXPECT_TRUE(Contains(message, "did not come to rest")) << message;
 }
 
