@@ -3,7 +3,7 @@
 #include <csetjmp>
 #include <cstdio>
 #include <cstdlib>
-#include <cstring>
+#include <mutex>
 
 #include <mujoco/mujoco.h>
 
@@ -45,8 +45,11 @@ void OnMujocoWarning(const char* message) {
 }  // namespace
 
 void InstallMujocoErrorHandlers() {
-  mju_user_error = &OnMujocoError;
-  mju_user_warning = &OnMujocoWarning;
+  // The hooks are process-wide; scenes may be loaded on several threads.
+  static std::mutex mutex;
+  const std::lock_guard<std::mutex> lock(mutex);
+  if (mju_user_error != &OnMujocoError) mju_user_error = &OnMujocoError;
+  if (mju_user_warning != &OnMujocoWarning) mju_user_warning = &OnMujocoWarning;
 }
 
 std::string MujocoVersion() { return mj_versionString(); }
