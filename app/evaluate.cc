@@ -11,7 +11,7 @@
 #include "app/run_files.h"
 #include "common/rng.h"
 #include "sim/obstacles.h"
-#include "sim/simulator.h"
+#include "sim/scene.h"
 
 namespace mjslam::app {
 namespace {
@@ -45,10 +45,9 @@ eval::Map RunGroundTruth(const std::string& run_dir, const eval::GroundTruthPara
     throw std::runtime_error(config_path + ": missing (is '" + run_dir + "' a run directory?)");
   }
   const RunConfig config = LoadRunConfig(config_path, {});
-  const sim::Simulator simulator(config.run.world, config.run.robot_model, config.sim,
-                                 config.robot);
+  const sim::Scene scene(config.run.world, config.run.robot_model);
   std::vector<eval::WallRectangle> walls;
-  for (const sim::ObstacleFootprint& obstacle : simulator.Obstacles()) {
+  for (const sim::ObstacleFootprint& obstacle : scene.Obstacles()) {
     if (obstacle.shape != sim::ObstacleFootprint::Shape::kRectangle) continue;
     const std::array<Eigen::Vector2d, 4> corners = sim::RectangleCorners(obstacle);
     walls.push_back({corners});
@@ -56,7 +55,7 @@ eval::Map RunGroundTruth(const std::string& run_dir, const eval::GroundTruthPara
   try {
     // Only what faces the free space the robot starts in.
     return eval::ReachableFeatures(eval::BuildGroundTruthMap(walls, params), walls,
-                                   simulator.X_WR().translation());
+                                   scene.StartPose().translation());
   } catch (const std::invalid_argument& error) {
     throw std::runtime_error(config.run.world + ": " + error.what());
   }

@@ -42,10 +42,11 @@ struct RunEvaluation {
 };
 
 /// The true map of the run's world: the wall (box) footprints of
-/// sim::Simulator::Obstacles() of the world in the run's config.yaml, through
-/// eval::BuildGroundTruthMap, restricted to the features that face the free
-/// space reachable from the robot's start (eval::ReachableFeatures); pillars
-/// (round or other non-box geoms) are left out. Throws naming the file when the run directory's config or world
+/// sim::Scene::Obstacles() of the world in the run's config.yaml (no physics
+/// is run), through eval::BuildGroundTruthMap, restricted to the features
+/// that face the free space reachable from the world's start site
+/// (eval::ReachableFeatures); pillars (round or other non-box geoms) are left
+/// out. Throws naming the file when the run directory's config or world
 /// cannot be loaded.
 eval::Map RunGroundTruth(const std::string& run_dir, const eval::GroundTruthParams& params = {});
 

@@ -5,11 +5,12 @@
 
 #include "app/map_csv.h"
 #include "app/scene_frame.h"
+#include "sim/scene.h"
 
 namespace mjslam::app {
 LiveVideo::LiveVideo(const RunConfig& config, const std::string& run_dir)
     : params_(config.render),
-      renderer_(config.run.world, config.run.robot_model, config.sim, config.robot,
+      renderer_(sim::Scene(config.run.world, config.run.robot_model), config.sim, config.robot,
                 config.render.width, config.render.height),
       video_(run_dir + "/video.mp4", config.render.width, config.render.height, config.render.fps,
              config.render.crf) {

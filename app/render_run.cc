@@ -20,6 +20,7 @@
 #include "app/scene_frame.h"
 #include "renders/scene_renderer.h"
 #include "renders/video_writer.h"
+#include "sim/scene.h"
 
 extern char** environ;
 
@@ -145,8 +146,8 @@ RenderResult RenderRun(const std::string& run_dir, const renders::RenderParams& 
   const int scan_y = scans.ColumnIndex("y"), scan_th = scans.ColumnIndex("th");
   const int scan_r0 = scans.ColumnIndex("r0");
 
-  renders::SceneRenderer renderer(config.run.world, config.run.robot_model, config.sim, config.robot,
-                                  params.width, params.height);
+  renders::SceneRenderer renderer(sim::Scene(config.run.world, config.run.robot_model), config.sim,
+                                  config.robot, params.width, params.height);
   const double min_step_m = PixelSizeM(renderer);
   frame.ellipse_scale = params.ellipse_scale;
   std::size_t next_row = 0;

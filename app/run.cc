@@ -118,7 +118,7 @@ RunResult RunSimulation(const RunConfig& config, const RunOptions& options) {
     } else {
       std::vector<Eigen::Vector2d> waypoints;
       for (const auto& p : config.driver.waypoints) waypoints.emplace_back(p[0], p[1]);
-      if (waypoints.empty()) waypoints = simulator.TourWaypoints();
+      if (waypoints.empty()) waypoints = simulator.scene().TourWaypoints();
       driver.emplace(config.driver, waypoints, a_m);
     }
     // The tour driver steers from the true pose; the explorer from pose_source.
@@ -126,7 +126,7 @@ RunResult RunSimulation(const RunConfig& config, const RunOptions& options) {
 
     const double dt = 1.0 / config.run.control_rate_hz;
     SlamPair slam(config.slam, config.control, dt, X_WR0, X_RS);
-    TrueCoverage coverage(simulator.Obstacles(), (X_WR0 * Pose2(-a_m, 0.0, 0.0)).translation());
+    TrueCoverage coverage(simulator.scene().Obstacles(), (X_WR0 * Pose2(-a_m, 0.0, 0.0)).translation());
     std::optional<LiveVideo> video;
     if (options.render_video) video.emplace(config, dir);
 

@@ -7,21 +7,17 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
-#include <filesystem>
 #include <stdexcept>
 
 #include "common/check.h"
 #include "sim/obstacles.h"
+#include "sim/scene_model.h"
 #include "sim/simulator.h"
 
 namespace mjslam::renders {
 
 namespace {
 
-namespace fs = std::filesystem;
-
-// The wrapper MJCF in MuJoCo's virtual file system (see sim/README.md).
-constexpr char kSceneFileName[] = "mjslam_render_scene.xml";
 // Height of the camera above the floor, metres; the frustum is narrow.
 constexpr double kCameraHeightM = 200.0;
 // Heights of the drawn layers, metres: paths on the floor under the robot;
@@ -39,11 +35,10 @@ constexpr int kMinWidthForLegend = 400;
 constexpr float kWallGrey = 0.30f;
 constexpr float kFloorGrey = 0.88f;
 
-struct VfsDeleter {
-  void operator()(mjVFS* vfs) const {
-    mj_deleteVFS(vfs);
-    delete vfs;
-  }
+// One line of the legend: a swatch and its name.
+struct LegendEntry {
+  std::string text;
+  Rgb color;
 };
 
 }  // namespace
@@ -56,6 +51,10 @@ struct SceneRenderer::Impl {
   double control_point_offset_m = 0.0;
   std::vector<double> rest_qpos;
 
+  // The renderer's copy of the scene's model (its colours and visual
+  // options are changed) and the state drawn.
+  sim::internal::ModelPtr model;
+  sim::internal::DataPtr data;
   mjModel* m = nullptr;
   mjData* d = nullptr;
   mjvScene scn;
@@ -71,11 +70,18 @@ struct SceneRenderer::Impl {
   double half_width_m = 1.0;
   double half_height_m = 1.0;
 
+  Impl() {
+    // Defaults first, so that the destructor may free them whatever stage
+    // the construction reached.
+    mjv_defaultScene(&scn);
+    mjr_defaultContext(&con);
+  }
+
   ~Impl() {
     mjr_freeContext(&con);
     mjv_freeScene(&scn);
-    if (d != nullptr) mj_deleteData(d);
-    if (m != nullptr) mj_deleteModel(m);
+    data.reset();
+    model.reset();
     if (gl != nullptr) OSMesaDestroyContext(gl);
   }
 
@@ -166,12 +172,24 @@ struct SceneRenderer::Impl {
     AddPolyline(points, z, color, 2.5);
   }
 
-  void DrawLegend(const SceneFrame& frame);
+  // Construction stages.
+  void LoadModel(const sim::Scene& scene, const std::vector<double>& rest);
+  void UsePlainLook();
+  void FrameView(const std::vector<sim::ObstacleFootprint>& obstacles,
+                 const Eigen::Vector2d& start);
+  void StartOpenGl();
+
+  // Render stages.
+  void PlaceRobot(const Pose2& X_WR_true);
+  void PointCameraDown();
+  void AddLayers(const SceneFrame& frame);
+  Image DrawAndRead(const SceneFrame& frame);
+  std::vector<LegendEntry> LegendEntries(const SceneFrame& frame) const;
+  void DrawLegend(const std::vector<LegendEntry>& entries, double ellipse_scale);
 };
 
-SceneRenderer::SceneRenderer(const std::string& world_path, const std::string& robot_model_path,
-                             const sim::SimParams& sim, const sim::RobotParams& robot, int width,
-                             int height)
+SceneRenderer::SceneRenderer(const sim::Scene& scene, const sim::SimParams& sim,
+                             const sim::RobotParams& robot, int width, int height)
     : impl_(std::make_unique<Impl>()) {
   MJSLAM_CHECK(width >= 16 && height >= 16);
   Impl& r = *impl_;
@@ -181,51 +199,49 @@ SceneRenderer::SceneRenderer(const std::string& world_path, const std::string& r
   r.fontscale = width >= 1280 ? mjFONTSCALE_200 : (width >= 960 ? mjFONTSCALE_150 : mjFONTSCALE_100);
   r.legend_width = width >= kMinWidthForLegend ? kLegendWidth * r.fontscale / 100 : 0;
 
-  // The simulator composes and checks the files, and settles the robot: its
-  // rest height and wheel angles are what the renders show.
-  const sim::Simulator simulator(world_path, robot_model_path, sim, robot);
-  r.rest_qpos = simulator.QPos();
+  // The robot as it rests on the floor at the start: its height and wheel
+  // angles after settling are what the renders show, so the physics runs
+  // once on the same scene.
+  const sim::Simulator settled(scene, sim, robot);
+  r.LoadModel(scene, settled.QPos());
+  r.UsePlainLook();
+  r.FrameView(scene.Obstacles(), settled.X_WR().translation());
+  r.StartOpenGl();
+}
 
-  // The same composed scene, loaded here for drawing.
-  const fs::path world_dir = fs::path(simulator.world_path()).parent_path();
-  const std::string& scene_xml = simulator.SceneXml();
-  std::unique_ptr<mjVFS, VfsDeleter> vfs(new mjVFS);
-  mj_defaultVFS(vfs.get());
-  MJSLAM_CHECK(mj_makeEmptyFileVFS(vfs.get(), kSceneFileName, static_cast<int>(scene_xml.size())) == 0);
-  const int file = mj_findFileVFS(vfs.get(), kSceneFileName);
-  MJSLAM_CHECK(file >= 0);
-  std::memcpy(vfs->filedata[file], scene_xml.data(), scene_xml.size());
-  char error[1024] = "";
-  r.m = mj_loadXML((world_dir / kSceneFileName).string().c_str(), vfs.get(), error, sizeof(error));
-  if (r.m == nullptr) {
-    throw std::runtime_error("cannot load the scene of '" + world_path + "' for rendering: " + error);
-  }
-  r.d = mj_makeData(r.m);
-  MJSLAM_CHECK(r.d != nullptr);
-  MJSLAM_CHECK(static_cast<int>(r.rest_qpos.size()) == r.m->nq);
+void SceneRenderer::Impl::LoadModel(const sim::Scene& scene, const std::vector<double>& rest) {
+  model = sim::internal::CopyModel(sim::internal::SceneAccess::Model(scene),
+                                   "preparing the scene for rendering");
+  m = model.get();
+  data = sim::internal::MakeData(*m, "preparing the scene for rendering");
+  d = data.get();
+  rest_qpos = rest;
+  MJSLAM_CHECK(static_cast<int>(rest_qpos.size()) == m->nq);
+}
 
+void SceneRenderer::Impl::UsePlainLook() {
   // Fast software rendering: no multisampling, few slices; the off-screen
   // buffer is the image.
-  r.m->vis.global.offwidth = width;
-  r.m->vis.global.offheight = height;
-  r.m->vis.quality.offsamples = 0;
-  r.m->vis.quality.numslices = 16;
-  r.m->vis.quality.numstacks = 8;
-  r.m->vis.quality.numquads = 1;
+  m->vis.global.offwidth = width;
+  m->vis.global.offheight = height;
+  m->vis.quality.offsamples = 0;
+  m->vis.quality.numslices = 16;
+  m->vis.quality.numstacks = 8;
+  m->vis.quality.numquads = 1;
   // Only the headlight, so that a face seen from above shows its own colour
   // (ambient + diffuse = 1): colours in the image are those of colors::.
-  for (int i = 0; i < r.m->nlight; ++i) r.m->light_active[i] = 0;
-  r.m->vis.headlight.ambient[0] = r.m->vis.headlight.ambient[1] = r.m->vis.headlight.ambient[2] = 0.5f;
-  r.m->vis.headlight.diffuse[0] = r.m->vis.headlight.diffuse[1] = r.m->vis.headlight.diffuse[2] = 0.5f;
-  r.m->vis.headlight.specular[0] = r.m->vis.headlight.specular[1] = r.m->vis.headlight.specular[2] = 0.0f;
-  r.m->vis.headlight.active = 1;
+  for (int i = 0; i < m->nlight; ++i) m->light_active[i] = 0;
+  m->vis.headlight.ambient[0] = m->vis.headlight.ambient[1] = m->vis.headlight.ambient[2] = 0.5f;
+  m->vis.headlight.diffuse[0] = m->vis.headlight.diffuse[1] = m->vis.headlight.diffuse[2] = 0.5f;
+  m->vis.headlight.specular[0] = m->vis.headlight.specular[1] = m->vis.headlight.specular[2] = 0.0f;
+  m->vis.headlight.active = 1;
 
   // Plain colours (textures cost time in software rendering): a light floor,
   // dark grey walls, so that the paths and the map stand out, and a red
   // robot.
-  for (int g = 0; g < r.m->ngeom; ++g) {
-    float* rgba = r.m->geom_rgba + 4 * g;
-    if (r.m->geom_group[g] == 5) {
+  for (int g = 0; g < m->ngeom; ++g) {
+    float* rgba = m->geom_rgba + 4 * g;
+    if (m->geom_group[g] == sim::internal::kRobotGeomGroup) {
       if (rgba[3] > 0.0f) {
         rgba[0] = colors::kRobot[0];
         rgba[1] = colors::kRobot[1];
@@ -233,16 +249,19 @@ SceneRenderer::SceneRenderer(const std::string& world_path, const std::string& r
       }
       continue;
     }
-    r.m->geom_matid[g] = -1;
-    const float grey = r.m->geom_type[g] == mjGEOM_PLANE ? kFloorGrey : kWallGrey;
+    m->geom_matid[g] = -1;
+    const float grey = m->geom_type[g] == mjGEOM_PLANE ? kFloorGrey : kWallGrey;
     rgba[0] = rgba[1] = rgba[2] = grey;
     rgba[3] = 1.0f;
   }
+}
 
-  // The floor area to show: the obstacles' footprints with a margin, at the
-  // aspect of the scene viewport.
+void SceneRenderer::Impl::FrameView(const std::vector<sim::ObstacleFootprint>& obstacles,
+                                    const Eigen::Vector2d& start) {
+  // The floor area to show: the obstacles' footprints and the start with a
+  // margin, at the aspect of the scene viewport.
   Eigen::Vector2d lo(1e300, 1e300), hi(-1e300, -1e300);
-  for (const sim::ObstacleFootprint& o : simulator.Obstacles()) {
+  for (const sim::ObstacleFootprint& o : obstacles) {
     const double c = std::cos(o.X_WO.theta), s = std::sin(o.X_WO.theta);
     Eigen::Vector2d half;
     if (o.shape == sim::ObstacleFootprint::Shape::kRectangle) {
@@ -254,42 +273,44 @@ SceneRenderer::SceneRenderer(const std::string& world_path, const std::string& r
     lo = lo.cwiseMin(o.X_WO.translation() - half);
     hi = hi.cwiseMax(o.X_WO.translation() + half);
   }
-  const Eigen::Vector2d start = simulator.X_WR().translation();
   lo = lo.cwiseMin(start - Eigen::Vector2d(1.0, 1.0));
   hi = hi.cwiseMax(start + Eigen::Vector2d(1.0, 1.0));
   const double margin_m = 0.04 * std::max(hi.x() - lo.x(), hi.y() - lo.y());
-  r.view_center = 0.5 * (lo + hi);
-  const double aspect = static_cast<double>(width - r.legend_width) / height;
-  r.half_height_m = std::max(0.5 * (hi.y() - lo.y()), 0.5 * (hi.x() - lo.x()) / aspect) + margin_m;
-  r.half_width_m = r.half_height_m * aspect;
+  view_center = 0.5 * (lo + hi);
+  const double aspect = static_cast<double>(width - legend_width) / height;
+  half_height_m = std::max(0.5 * (hi.y() - lo.y()), 0.5 * (hi.x() - lo.x()) / aspect) + margin_m;
+  half_width_m = half_height_m * aspect;
+}
 
+void SceneRenderer::Impl::StartOpenGl() {
   // OSMesa: a software OpenGL context drawing into memory.
-  r.gl = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 8, nullptr);
-  if (r.gl == nullptr) throw std::runtime_error("OSMesa: cannot create an OpenGL context");
-  r.gl_buffer.resize(static_cast<std::size_t>(width) * height * 4);
-  if (!OSMesaMakeCurrent(r.gl, r.gl_buffer.data(), GL_UNSIGNED_BYTE, width, height)) {
+  gl = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 8, nullptr);
+  if (gl == nullptr) throw std::runtime_error("OSMesa: cannot create an OpenGL context");
+  gl_buffer.resize(static_cast<std::size_t>(width) * height * 4);
+  if (!OSMesaMakeCurrent(gl, gl_buffer.data(), GL_UNSIGNED_BYTE, width, height)) {
     throw std::runtime_error("OSMesa: cannot make the OpenGL context current");
   }
 
-  mjv_defaultCamera(&r.cam);
-  mjv_defaultOption(&r.opt);
+  // MuJoCo's abstract scene and its OpenGL context, drawing off-screen.
+  mjv_defaultCamera(&cam);
+  mjv_defaultOption(&opt);
   for (int i = 0; i < mjNGROUP; ++i) {
-    r.opt.geomgroup[i] = 1;  // the robot is group 5
-    r.opt.sitegroup[i] = 0;  // no start, tour or laser sites
+    opt.geomgroup[i] = 1;  // the robot is group 5
+    opt.sitegroup[i] = 0;  // no start, tour or laser sites
   }
-  mjv_defaultScene(&r.scn);
-  mjv_makeScene(r.m, &r.scn, r.m->ngeom + kMaxGeoms);
-  r.scn.flags[mjRND_SHADOW] = 0;
-  r.scn.flags[mjRND_REFLECTION] = 0;
-  r.scn.flags[mjRND_SKYBOX] = 0;
-  r.scn.flags[mjRND_FOG] = 0;
-  mjr_defaultContext(&r.con);
-  mjr_makeContext(r.m, &r.con, r.fontscale);
-  mjr_setBuffer(mjFB_OFFSCREEN, &r.con);
-  if (r.con.currentBuffer != mjFB_OFFSCREEN) {
+  sim::CallMujoco("starting MuJoCo's renderer", [&] {
+    mjv_makeScene(m, &scn, m->ngeom + kMaxGeoms);
+    scn.flags[mjRND_SHADOW] = 0;
+    scn.flags[mjRND_REFLECTION] = 0;
+    scn.flags[mjRND_SKYBOX] = 0;
+    scn.flags[mjRND_FOG] = 0;
+    mjr_makeContext(m, &con, fontscale);
+    mjr_setBuffer(mjFB_OFFSCREEN, &con);
+  });
+  if (con.currentBuffer != mjFB_OFFSCREEN) {
     throw std::runtime_error("MuJoCo: the off-screen buffer is not available");
   }
-  r.readback.resize(static_cast<std::size_t>(width) * height * 3);
+  readback.resize(static_cast<std::size_t>(width) * height * 3);
 }
 
 SceneRenderer::~SceneRenderer() = default;
@@ -307,25 +328,36 @@ Eigen::Vector2d SceneRenderer::PixelOf(const Eigen::Vector2d& p_W) const {
 
 Image SceneRenderer::Render(const SceneFrame& frame) {
   Impl& r = *impl_;
+  r.PlaceRobot(frame.X_WR_true);
+  r.PointCameraDown();
+  r.AddLayers(frame);
+  return r.DrawAndRead(frame);
+}
 
-  // The robot at its true pose: the body origin is the axle centre A.
-  const Pose2 X_WA = frame.X_WR_true * Pose2(-r.control_point_offset_m, 0.0, 0.0);
-  std::copy(r.rest_qpos.begin(), r.rest_qpos.end(), r.d->qpos);
-  r.d->qpos[0] = X_WA.x;
-  r.d->qpos[1] = X_WA.y;
-  r.d->qpos[3] = std::cos(0.5 * X_WA.theta);
-  r.d->qpos[4] = 0.0;
-  r.d->qpos[5] = 0.0;
-  r.d->qpos[6] = std::sin(0.5 * X_WA.theta);
-  mj_kinematics(r.m, r.d);
-  mj_camlight(r.m, r.d);
-  mjv_updateScene(r.m, r.d, &r.opt, nullptr, &r.cam, mjCAT_ALL, &r.scn);
+void SceneRenderer::Impl::PlaceRobot(const Pose2& X_WR_true) {
+  // The robot at its true pose (the body origin is the axle centre A), at
+  // its rest height and wheel angles; the world's geoms into the scene.
+  const Pose2 X_WA = X_WR_true * Pose2(-control_point_offset_m, 0.0, 0.0);
+  std::copy(rest_qpos.begin(), rest_qpos.end(), d->qpos);
+  d->qpos[0] = X_WA.x;
+  d->qpos[1] = X_WA.y;
+  d->qpos[3] = std::cos(0.5 * X_WA.theta);
+  d->qpos[4] = 0.0;
+  d->qpos[5] = 0.0;
+  d->qpos[6] = std::sin(0.5 * X_WA.theta);
+  sim::CallMujoco("updating the rendered scene", [&] {
+    mj_kinematics(m, d);
+    mj_camlight(m, d);
+    mjv_updateScene(m, d, &opt, nullptr, &cam, mjCAT_ALL, &scn);
+  });
+}
 
+void SceneRenderer::Impl::PointCameraDown() {
   // The camera straight above the view centre, north up.
   const double near_m = kCameraHeightM - 5.0;
-  for (mjvGLCamera& c : r.scn.camera) {
-    c.pos[0] = static_cast<float>(r.view_center.x());
-    c.pos[1] = static_cast<float>(r.view_center.y());
+  for (mjvGLCamera& c : scn.camera) {
+    c.pos[0] = static_cast<float>(view_center.x());
+    c.pos[1] = static_cast<float>(view_center.y());
     c.pos[2] = static_cast<float>(kCameraHeightM);
     c.forward[0] = 0.0f;
     c.forward[1] = 0.0f;
@@ -334,34 +366,34 @@ Image SceneRenderer::Render(const SceneFrame& frame) {
     c.up[1] = 1.0f;
     c.up[2] = 0.0f;
     c.frustum_center = 0.0f;
-    c.frustum_top = static_cast<float>(r.half_height_m * near_m / kCameraHeightM);
+    c.frustum_top = static_cast<float>(half_height_m * near_m / kCameraHeightM);
     c.frustum_bottom = -c.frustum_top;
     c.frustum_near = static_cast<float>(near_m);
     c.frustum_far = static_cast<float>(kCameraHeightM + 1.0);
   }
-  r.scn.enabletransform = 0;
+  scn.enabletransform = 0;
   // Matte surfaces: a specular highlight would wash out the top faces.
-  for (int i = 0; i < r.scn.ngeom; ++i) r.scn.geoms[i].specular = 0.0f;
+  for (int i = 0; i < scn.ngeom; ++i) scn.geoms[i].specular = 0.0f;
   // Beyond the floor plane: a floor-coloured slab under the whole view.
-  {
-    mjvGeom* g = r.NewGeom();
-    const float rgba[4] = {kFloorGrey, kFloorGrey, kFloorGrey, 1.0f};
-    const mjtNum size[3] = {2.0 * r.half_width_m, 2.0 * r.half_height_m, 0.01};
-    const mjtNum pos[3] = {r.view_center.x(), r.view_center.y(), -0.05};
-    mjv_initGeom(g, mjGEOM_BOX, size, pos, nullptr, rgba);
-    g->category = mjCAT_DECOR;
-    g->specular = 0.0f;
-  }
+  mjvGeom* g = NewGeom();
+  const float rgba[4] = {kFloorGrey, kFloorGrey, kFloorGrey, 1.0f};
+  const mjtNum size[3] = {2.0 * half_width_m, 2.0 * half_height_m, 0.01};
+  const mjtNum pos[3] = {view_center.x(), view_center.y(), -0.05};
+  mjv_initGeom(g, mjGEOM_BOX, size, pos, nullptr, rgba);
+  g->category = mjCAT_DECOR;
+  g->specular = 0.0f;
+}
 
+void SceneRenderer::Impl::AddLayers(const SceneFrame& frame) {
   // Layers, bottom to top: planned path and frontier, true path, estimated
   // paths; then the maps, the laser hits and the ellipses above the walls.
-  const double pixel_m = 2.0 * r.half_height_m / r.height;
+  const double pixel_m = 2.0 * half_height_m / height;
   if (frame.explorer) {
-    r.AddPolyline(frame.explorer->path, kFloorLayerZ, colors::kPlannedPath, 2.0);
+    AddPolyline(frame.explorer->path, kFloorLayerZ, colors::kPlannedPath, 2.0);
     for (const Eigen::Vector2d& p : frame.explorer->frontier) {
-      r.AddMarker(p, kFloorLayerZ, 1.5 * pixel_m, colors::kFrontier);
+      AddMarker(p, kFloorLayerZ, 1.5 * pixel_m, colors::kFrontier);
     }
-    if (frame.explorer->goal) r.AddMarker(*frame.explorer->goal, kFloorLayerZ + 0.01, 4.0 * pixel_m, colors::kGoal);
+    if (frame.explorer->goal) AddMarker(*frame.explorer->goal, kFloorLayerZ + 0.01, 4.0 * pixel_m, colors::kGoal);
   }
   // The estimates and the truth often overlap: the first filter is drawn
   // widest, the next narrower on top, the truth thinnest on top of all, so
@@ -369,54 +401,57 @@ Image SceneRenderer::Render(const SceneFrame& frame) {
   const std::size_t n = frame.filters.size();
   auto width_of = [n](std::size_t i) { return 2.0 + 2.0 * static_cast<double>(n - i); };
   for (std::size_t i = 0; i < n; ++i) {
-    r.AddPolyline(frame.filters[i].path, kFloorLayerZ + 0.01 * (i + 1), frame.filters[i].color, width_of(i));
+    AddPolyline(frame.filters[i].path, kFloorLayerZ + 0.01 * (i + 1), frame.filters[i].color, width_of(i));
   }
-  r.AddPolyline(frame.true_path, kFloorLayerZ + 0.01 * (n + 1), colors::kTruth, 1.5);
+  AddPolyline(frame.true_path, kFloorLayerZ + 0.01 * (n + 1), colors::kTruth, 1.5);
   for (std::size_t i = 0; i < n; ++i) {
     const FilterLayer& f = frame.filters[i];
-    for (const Segment2& s : f.lines) r.AddSegment(s.a, s.b, kMapLayerZ + 0.005 * i, f.color, width_of(i));
+    for (const Segment2& s : f.lines) AddSegment(s.a, s.b, kMapLayerZ + 0.005 * i, f.color, width_of(i));
     const double half_m = (1.5 + 1.5 * static_cast<double>(n - i)) * pixel_m;
-    for (const Eigen::Vector2d& p : f.corners) r.AddMarker(p, kMapLayerZ + 0.005 * i, half_m, f.color);
+    for (const Eigen::Vector2d& p : f.corners) AddMarker(p, kMapLayerZ + 0.005 * i, half_m, f.color);
   }
-  for (const Eigen::Vector2d& p : frame.laser_hits) r.AddMarker(p, kHitLayerZ, 1.0 * pixel_m, colors::kLaserHits);
+  for (const Eigen::Vector2d& p : frame.laser_hits) AddMarker(p, kHitLayerZ, 1.0 * pixel_m, colors::kLaserHits);
   for (std::size_t i = 0; i < frame.filters.size(); ++i) {
     const FilterLayer& f = frame.filters[i];
     if (f.X_WR) {
-      r.AddEllipse(f.X_WR->translation(), f.P_xy, 2.0 * frame.ellipse_scale, kEllipseLayerZ + 0.01 * i, f.color);
+      AddEllipse(f.X_WR->translation(), f.P_xy, 2.0 * frame.ellipse_scale, kEllipseLayerZ + 0.01 * i, f.color);
     }
   }
+}
 
-  // Render, then the 2D overlays.
-  const mjrRect full = {0, 0, r.width, r.height};
-  mjr_rectangle(full, 1.0f, 1.0f, 1.0f, 1.0f);
-  mjr_render(r.SceneViewport(), &r.scn, &r.con);
+Image SceneRenderer::Impl::DrawAndRead(const SceneFrame& frame) {
+  // The legend's lines and the time are prepared first: the trapped MuJoCo
+  // calls below may only touch plain data.
+  const std::vector<LegendEntry> legend =
+      legend_width > 0 ? LegendEntries(frame) : std::vector<LegendEntry>();
   char time_text[64];
   std::snprintf(time_text, sizeof(time_text), "t = %.1f s", frame.t_s);
-  mjr_overlay(mjFONT_NORMAL, mjGRID_TOPLEFT, r.SceneViewport(), time_text, nullptr, &r.con);
-  if (r.legend_width > 0) r.DrawLegend(frame);
 
-  // Read back (OpenGL rows are bottom-up).
-  mjr_readPixels(r.readback.data(), nullptr, full, &r.con);
+  // Render, then the 2D overlays, then read back.
+  const mjrRect full = {0, 0, width, height};
+  sim::CallMujoco("drawing a frame", [&] {
+    mjr_rectangle(full, 1.0f, 1.0f, 1.0f, 1.0f);
+    mjr_render(SceneViewport(), &scn, &con);
+    mjr_overlay(mjFONT_NORMAL, mjGRID_TOPLEFT, SceneViewport(), time_text, nullptr, &con);
+    if (legend_width > 0) DrawLegend(legend, frame.ellipse_scale);
+    mjr_readPixels(readback.data(), nullptr, full, &con);
+  });
+
+  // OpenGL rows are bottom-up.
   Image image;
-  image.width = r.width;
-  image.height = r.height;
-  image.rgb.resize(r.readback.size());
-  const std::size_t row_bytes = static_cast<std::size_t>(r.width) * 3;
-  for (int y = 0; y < r.height; ++y) {
+  image.width = width;
+  image.height = height;
+  image.rgb.resize(readback.size());
+  const std::size_t row_bytes = static_cast<std::size_t>(width) * 3;
+  for (int y = 0; y < height; ++y) {
     std::memcpy(image.rgb.data() + y * row_bytes,
-                r.readback.data() + (r.height - 1 - y) * row_bytes, row_bytes);
+                readback.data() + (height - 1 - y) * row_bytes, row_bytes);
   }
   return image;
 }
 
-void SceneRenderer::Impl::DrawLegend(const SceneFrame& frame) {
-  const mjrRect panel = {width - legend_width, 0, legend_width, height};
-  mjr_rectangle(panel, 1.0f, 1.0f, 1.0f, 1.0f);
-  struct Entry {
-    std::string text;
-    Rgb color;
-  };
-  std::vector<Entry> entries = {{"true path", colors::kTruth}};
+std::vector<LegendEntry> SceneRenderer::Impl::LegendEntries(const SceneFrame& frame) const {
+  std::vector<LegendEntry> entries = {{"true path", colors::kTruth}};
   for (const FilterLayer& f : frame.filters) entries.push_back({f.name, f.color});
   entries.push_back({"laser hits", colors::kLaserHits});
   entries.push_back({"robot (true pose)", colors::kRobot});
@@ -424,6 +459,15 @@ void SceneRenderer::Impl::DrawLegend(const SceneFrame& frame) {
     entries.push_back({"frontier, goal", colors::kFrontier});
     entries.push_back({"planned path", colors::kPlannedPath});
   }
+  return entries;
+}
+
+// Runs inside a trapped MuJoCo call: plain data only (no object with a
+// destructor is created here).
+void SceneRenderer::Impl::DrawLegend(const std::vector<LegendEntry>& entries,
+                                     double ellipse_scale) {
+  const mjrRect panel = {width - legend_width, 0, legend_width, height};
+  mjr_rectangle(panel, 1.0f, 1.0f, 1.0f, 1.0f);
   const int line_height = con.charHeight + 6 * fontscale / 100;
   const int swatch = con.charHeight - 2;
   const int x0 = panel.left + 8 * fontscale / 100;
@@ -432,18 +476,18 @@ void SceneRenderer::Impl::DrawLegend(const SceneFrame& frame) {
   // (mjr_label centres its text).
   const int label_left = x0 + swatch + 6 * fontscale / 100;
   const int label_width = panel.left + panel.width - label_left - 4;
-  auto label_at = [&](const std::string& text, int left, int bottom, int label_w) {
-    mjr_label({left, bottom, label_w, line_height}, mjFONT_NORMAL, text.c_str(), 1.0f, 1.0f, 1.0f, 1.0f,
+  auto label_at = [&](const char* text, int left, int bottom, int label_w) {
+    mjr_label({left, bottom, label_w, line_height}, mjFONT_NORMAL, text, 1.0f, 1.0f, 1.0f, 1.0f,
               0.0f, 0.0f, 0.0f, &con);
   };
-  for (const Entry& e : entries) {
+  for (const LegendEntry& e : entries) {
     mjr_rectangle({x0, y + (line_height - swatch) / 2, swatch, swatch}, e.color[0], e.color[1],
                   e.color[2], 1.0f);
-    label_at(e.text, label_left, y, label_width);
+    label_at(e.text.c_str(), label_left, y, label_width);
     y -= line_height;
   }
   char scale_text[64];
-  std::snprintf(scale_text, sizeof(scale_text), "ellipses 2sd x%g", frame.ellipse_scale);
+  std::snprintf(scale_text, sizeof(scale_text), "ellipses 2sd x%g", ellipse_scale);
   label_at(scale_text, x0, y, panel.left + panel.width - x0 - 4);
   y -= line_height;
 

@@ -10,6 +10,7 @@
 
 #include "common/pose2.h"
 #include "renders/image.h"
+#include "sim/scene.h"
 #include "sim/sim_params.h"
 
 namespace mjslam::renders {
@@ -87,18 +88,22 @@ struct SceneFrame {
 /// process's current OpenGL context; use one at a time per thread.
 class SceneRenderer {
  public:
-  /// Composes `world_path` and `robot_model_path` as the simulator does
-  /// (sim::Simulator, which also checks them) and creates a `width` x `height`
-  /// off-screen context. Throws sim::SimError for a bad world or robot file,
+  /// Draws `scene` (a copy of its loaded model, in plain colours) in a
+  /// `width` x `height` off-screen context. The robot is drawn as it rests
+  /// on the floor: a sim::Simulator with `sim` and `robot` settles it once
+  /// at the scene's start (its height and wheel angles; the start also
+  /// bounds the view). Throws ParamError for invalid params, sim::SimError
+  /// when the robot does not settle or MuJoCo raises an error, and
   /// std::runtime_error when OSMesa or MuJoCo's renderer cannot start.
-  SceneRenderer(const std::string& world_path, const std::string& robot_model_path,
-                const sim::SimParams& sim, const sim::RobotParams& robot, int width, int height);
+  SceneRenderer(const sim::Scene& scene, const sim::SimParams& sim,
+                const sim::RobotParams& robot, int width, int height);
   ~SceneRenderer();
   SceneRenderer(const SceneRenderer&) = delete;
   SceneRenderer& operator=(const SceneRenderer&) = delete;
 
   /// Renders `frame`: the world, the robot at frame.X_WR_true, the layers,
-  /// a legend (bottom left) and the time (top left).
+  /// a legend (right-hand strip) and the time (top left). Throws
+  /// sim::SimError when MuJoCo raises an error or a warning.
   Image Render(const SceneFrame& frame);
 
   /// Pixel (column, row from the top, fractional) where the floor point p_W

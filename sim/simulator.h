@@ -3,49 +3,20 @@
 #include <array>
 #include <memory>
 #include <optional>
-#include <stdexcept>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
 
 #include "common/laser_scan.h"
 #include "common/pose2.h"
 #include "common/records.h"
-#include "sim/obstacles.h"
+#include "sim/mujoco_errors.h"
+#include "sim/scene.h"
 #include "sim/sim_params.h"
 
 namespace mjslam::sim {
 
-/// A problem with the simulation's input (world or robot file, start pose) or
-/// a physics failure (a MuJoCo error or warning). The message names the file
-/// and carries MuJoCo's own text.
-class SimError : public std::runtime_error {
- public:
-  explicit SimError(const std::string& message) : std::runtime_error(message) {}
-};
-
-/// Points MuJoCo's process-wide error and warning hooks (mju_user_error,
-/// mju_user_warning), where they are still unset, at handlers that throw
-/// SimError("MuJoCo error: ...") / SimError("MuJoCo warning: ..."). MuJoCo's
-/// defaults wait for a key press and exit (errors) or write MUJOCO_LOG.TXT
-/// (warnings). The Simulator calls this; a program or test that installs its
-/// own hooks first keeps them (they must not return: throw). After an error
-/// thrown from inside MuJoCo, the Simulator that was running is in an
-/// undefined state and must be discarded.
-void InstallMujocoErrorHandlers();
-
-/// MuJoCo's version string (for run manifests), e.g. "2.2.2".
-std::string MujocoVersion();
-
-/// The Pioneer 3-DX in a world, stepped by MuJoCo.
-///
-/// The world file is an MJCF file with a floor plane, static obstacle geoms, a
-/// site `start` (the default start pose of R: its x, y and yaw) and optionally
-/// sites `tour_0`, `tour_1`, ... (see worlds/README.md). The robot file is the
-/// robot's MJCF (models/pioneer3dx.xml; its required names are listed in
-/// models/README.md). The two are composed into one model by a wrapper that
-/// includes both, so any world file works without edits.
+/// The Pioneer 3-DX stepped by MuJoCo in a Scene (the physics on top of the
+/// scene: MuJoCo's mjData, the wheel-speed controllers, the clock).
 ///
 /// Frames: W the world; A the axle centre (the robot body's origin); R the
 /// point of control h, RobotParams::control_point_offset_m ahead of A on the
@@ -53,17 +24,19 @@ std::string MujocoVersion();
 /// the model's `laser` site. All poses are planar (x, y, yaw about z).
 class Simulator {
  public:
-  /// Loads and composes the world and robot files, checks them, places frame
-  /// R at `X_WR_start` (default: the world's `start` site), and lets the robot
-  /// settle on the floor for SimParams::settle_time_s; time_s() is then 0.
-  /// Throws SimError (naming the file and quoting MuJoCo's message) when a
-  /// file is missing or malformed, the world lacks the `start` site, uses
-  /// geom group 5 (reserved for the robot), has joints of its own, has
-  /// misnumbered tour sites, the robot model lacks a required name or
-  /// disagrees with `robot` (wheel radius or axle track by more than 1 mm),
-  /// the wheel-speed gain is unstable at the timestep, the start pose touches
-  /// an obstacle, or the robot does not come to rest. Throws ParamError for
-  /// invalid params.
+  /// Puts the physics on `scene` (sharing its loaded model; the simulator's
+  /// own copy carries SimParams::timestep_s), places frame R at `X_WR_start`
+  /// (default: scene.StartPose()), and lets the robot settle on the floor for
+  /// SimParams::settle_time_s; time_s() is then 0. Throws ParamError for
+  /// invalid params; SimError when the robot model disagrees with `robot`
+  /// (wheel radius or axle track by more than 1 mm), the wheel-speed gain is
+  /// unstable at the timestep, the start pose touches an obstacle, the robot
+  /// does not come to rest, or MuJoCo raises an error or a warning.
+  Simulator(Scene scene, const SimParams& sim, const RobotParams& robot,
+            std::optional<Pose2> X_WR_start = std::nullopt);
+  /// Validates the params, loads Scene(world_path, robot_model_path) (which
+  /// throws SimError for a bad file or a world that breaks the rules), and
+  /// puts the physics on it as above.
   Simulator(const std::string& world_path, const std::string& robot_model_path,
             const SimParams& sim, const RobotParams& robot,
             std::optional<Pose2> X_WR_start = std::nullopt);
@@ -87,9 +60,10 @@ class Simulator {
   /// Advances the physics by whole timesteps: after the call the simulated
   /// time is the multiple of the timestep nearest to the sum of all durations
   /// requested so far (so ten Advance(0.1) make exactly 1 s). Throws SimError
-  /// on any MuJoCo warning (instability, bad numbers, full contact buffer) or
-  /// if the robot leaves the floor (tips over, is launched); the simulator
-  /// must then be discarded. duration_s must be >= 0 (throws SimError).
+  /// on any MuJoCo error or warning (instability, bad numbers, full contact
+  /// buffer) or if the robot leaves the floor (tips over, is launched); the
+  /// simulator must then be discarded. duration_s must be >= 0 (throws
+  /// SimError).
   void Advance(double duration_s);
 
   /// Simulated time since the start of the run, seconds.
@@ -122,35 +96,23 @@ class Simulator {
   /// `beam_angle_offsets_rad` (empty, or one per beam): beam i is really cast
   /// at its bearing plus offset i (angular jitter, see LaserNoise) but the
   /// scan reports the nominal bearings. Throws ParamError for invalid
-  /// `laser`, SimError for a wrong number of offsets. Cast only at the scan
-  /// rate: it costs num_beams ray casts.
+  /// `laser`, SimError for a wrong number of offsets or a MuJoCo error. Cast
+  /// only at the scan rate: it costs num_beams ray casts.
   LaserScan CastLaser(const LaserParams& laser,
                       const std::vector<double>& beam_angle_offsets_rad = {}) const;
 
-  /// The world's sites tour_0, tour_1, ... in order: waypoints p_W for the
-  /// point h (x, y). Empty if the world has none.
-  std::vector<Eigen::Vector2d> TourWaypoints() const;
-  /// The world's `start` site as a pose of R (x, y, yaw).
-  Pose2 StartPose() const;
   /// Number of contacts between robot geoms and world geoms other than
   /// planes (the floor): 0 unless the robot touches an obstacle.
   int CountRobotWorldContacts() const;
-  /// Footprints of the world's obstacle geoms (everything but planes, height
-  /// fields and the robot), in the order of the model: the ground-truth map.
-  std::vector<ObstacleFootprint> Obstacles() const;
 
+  /// The scene the physics runs on (start, tour, obstacles, files).
+  const Scene& scene() const;
   /// The robot parameters in use.
   const RobotParams& robot() const;
-  /// Absolute paths of the loaded files.
-  const std::string& world_path() const;
-  const std::string& robot_model_path() const;
   /// The composed model's generalized positions (free joint x y z qw qx qy qz,
-  /// then the left and right wheel angles), e.g. to draw the same state in a
-  /// separately loaded copy of the scene (see SceneXml()).
+  /// then the left and right wheel angles), e.g. to draw the same state in
+  /// another copy of the scene's model (renders::SceneRenderer).
   std::vector<double> QPos() const;
-  /// The wrapper MJCF that composes the scene; it must be loaded from a file
-  /// in the world file's directory (its includes are relative to it).
-  const std::string& SceneXml() const;
 
  private:
   struct Impl;

@@ -9,7 +9,7 @@
 #include "app/evaluate.h"
 #include "app/run_config.h"
 #include "sim/obstacles.h"
-#include "sim/simulator.h"
+#include "sim/scene.h"
 #include "tests/integration/run_helpers.h"
 
 namespace mjslam::testing {
@@ -33,9 +33,9 @@ TEST_P(GroundTruthWorldTest, EveryEchoLiesOnATrueSegmentOrAPillar) {
       << ReadText(dir + ".log");
   const eval::Map truth = app::RunGroundTruth(dir);
   const app::RunConfig config = app::LoadRunConfig(dir + "/config.yaml", {});
-  const sim::Simulator simulator(config.run.world, config.run.robot_model, config.sim, config.robot);
+  const sim::Scene scene(config.run.world, config.run.robot_model);
   std::vector<sim::ObstacleFootprint> pillars;
-  for (const sim::ObstacleFootprint& o : simulator.Obstacles()) {
+  for (const sim::ObstacleFootprint& o : scene.Obstacles()) {
     if (o.shape == sim::ObstacleFootprint::Shape::kCircle) pillars.push_back(o);
   }
 

@@ -1,5 +1,6 @@
 // Renders a tiny world and checks pixels that must have a known colour: the
 // wall, the floor, the robot, a path segment, a map corner, a laser hit.
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 
@@ -49,8 +50,9 @@ class SceneRendererTest : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     world_ = new std::string(WriteTinyWorld());
-    renderer_ = new SceneRenderer(*world_, std::string(MJSLAM_SOURCE_DIR) + "/models/pioneer3dx.xml",
-                                  sim::SimParams{}, sim::RobotParams{}, 160, 120);
+    renderer_ = new SceneRenderer(
+        sim::Scene(*world_, std::string(MJSLAM_SOURCE_DIR) + "/models/pioneer3dx.xml"),
+        sim::SimParams{}, sim::RobotParams{}, 400, 160);
   }
   static void TearDownTestSuite() {
     delete renderer_;
@@ -74,8 +76,8 @@ TEST_F(SceneRendererTest, DrawsWallFloorRobotAndLayersInTheirColours) {
   frame.filters = {selective};
   frame.laser_hits = {{-2.0, 1.0}};
   const Image image = renderer_->Render(frame);
-  ASSERT_EQ(image.width, 160);
-  ASSERT_EQ(image.height, 120);
+  ASSERT_EQ(image.width, 400);
+  ASSERT_EQ(image.height, 160);
 
   // The wall is drawn dark grey, the floor light grey, whatever the world says.
   ExpectColor(ColorAt(*renderer_, image, {2.0, 1.0}), {0.30f, 0.30f, 0.30f}, "wall");
@@ -104,6 +106,36 @@ TEST_F(SceneRendererTest, PixelOfKeepsNorthUpAndEastRight) {
   // Same scale along both axes (square pixels).
   EXPECT_NEAR(renderer_->PixelOf({1.0, 0.0}).x() - origin.x(),
               origin.y() - renderer_->PixelOf({0.0, 1.0}).y(), 1e-9);
+}
+
+// Whether any pixel in columns [x0, x1) of `image` has colour `want`.
+bool AnyPixelOfColour(const Image& image, int x0, int x1, const Rgb& want) {
+  for (int y = 0; y < image.height; ++y) {
+    for (int x = x0; x < x1; ++x) {
+      bool same = true;
+      for (int c = 0; c < 3; ++c) same = same && std::abs(image.At(x, y, c) / 255.0f - want[c]) < 0.05f;
+      if (same) return true;
+    }
+  }
+  return false;
+}
+
+TEST_F(SceneRendererTest, ALegendStripListsTheLayersInTheirColours) {
+  SceneFrame frame;
+  frame.X_WR_true = Pose2(-1.0, 0.0, 0.0);
+  FilterLayer selective;
+  selective.name = "selective";
+  selective.color = colors::kSelective;
+  frame.filters = {selective};
+  const Image image = renderer_->Render(frame);
+  // Right of the wall there is only floor, then the legend strip (images at
+  // least 400 pixels wide) with a swatch per layer; nothing else in this
+  // frame is blue or green.
+  const int strip = static_cast<int>(renderer_->PixelOf({2.2, 0.0}).x());
+  ASSERT_LT(strip, 400 - 100);
+  EXPECT_TRUE(AnyPixelOfColour(image, strip, 400, colors::kSelective));
+  EXPECT_TRUE(AnyPixelOfColour(image, strip, 400, colors::kLaserHits));
+  EXPECT_FALSE(AnyPixelOfColour(image, 0, strip, colors::kSelective));
 }
 
 }  // namespace

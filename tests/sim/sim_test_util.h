@@ -1,8 +1,8 @@
 #pragma once
 
 // Helpers shared by the sim tests: inline MJCF worlds written to temporary
-// files, the robot model's path, and a fixture that turns MuJoCo errors and
-// warnings into test failures.
+// files, the robot model's path, and a fixture that installs the MuJoCo
+// error and warning handlers (sim/mujoco_errors.h) and cleans up.
 
 #include <filesystem>
 #include <fstream>
@@ -11,9 +11,8 @@
 #include <unistd.h>
 
 #include <gtest/gtest.h>
-#include <mujoco/mujoco.h>
 
-#include "sim/simulator.h"
+#include "sim/mujoco_errors.h"
 
 namespace mjslam::sim::testing {
 
@@ -53,28 +52,32 @@ inline std::string WorldXml(const std::string& body,
          start + "\n    " + body + "\n  </worldbody>\n</mujoco>\n";
 }
 
-inline void FailOnMujocoError(const char* message) {
-  ADD_FAILURE() << "MuJoCo error: " << message;
-  throw SimError(std::string("MuJoCo error: ") + message);  // must not return to MuJoCo
+/// A world the scene accepts but the physics rejects: no floor (the robot
+/// does not come to rest).
+inline std::string NoFloorWorldXml() {
+  return "<mujoco><worldbody><site name=\"start\"/></worldbody></mujoco>";
 }
 
-inline void FailOnMujocoWarning(const char* message) {
-  ADD_FAILURE() << "MuJoCo warning: " << message;
-  throw SimError(std::string("MuJoCo warning: ") + message);
+/// A world the scene accepts but the physics rejects: the start pose puts
+/// the robot's rear into the geom 'wall'.
+inline std::string StartInWallWorldXml() {
+  return WorldXml("<geom name=\"wall\" type=\"box\" size=\"0.1 2 0.5\" pos=\"-0.2 0 0.5\"/>");
 }
 
-/// Installs MuJoCo error and warning hooks that fail the running test (the
-/// Simulator keeps hooks that are already installed), and removes the test's
-/// temporary files afterwards.
+/// Whether `text` contains `part`.
+inline bool Contains(const std::string& text, const std::string& part) {
+  return text.find(part) != std::string::npos;
+}
+
+/// Installs the MuJoCo error and warning handlers before each test (so a
+/// MuJoCo error or warning in any trapped call becomes a SimError, which
+/// fails a test that does not expect it, and one outside a trapped call
+/// aborts the test program), and removes the test's temporary files
+/// afterwards.
 class MujocoTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    mju_user_error = &FailOnMujocoError;
-    mju_user_warning = &FailOnMujocoWarning;
-  }
+  void SetUp() override { InstallMujocoErrorHandlers(); }
   void TearDown() override {
-    mju_user_error = nullptr;
-    mju_user_warning = nullptr;
     std::error_code ignored;
     std::filesystem::remove_all(TempDir(), ignored);
   }

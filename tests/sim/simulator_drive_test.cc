@@ -52,9 +52,9 @@ TEST_F(SimulatorDriveTest, UsesTheWorldStartSiteByDefault) {
       "start_site_world.xml",
       WorldXml("", "<site name=\"start\" pos=\"2 3 0\" euler=\"0 0 -45\"/>"));
   Simulator sim(world, RobotModelPath(), SimParams{}, RobotParams{});
-  EXPECT_NEAR(sim.StartPose().x, 2.0, 1e-12);
-  EXPECT_NEAR(sim.StartPose().y, 3.0, 1e-12);
-  EXPECT_NEAR(sim.StartPose().theta, DegToRad(-45.0), 1e-12);
+  EXPECT_NEAR(sim.scene().StartPose().x, 2.0, 1e-12);
+  EXPECT_NEAR(sim.scene().StartPose().y, 3.0, 1e-12);
+  EXPECT_NEAR(sim.scene().StartPose().theta, DegToRad(-45.0), 1e-12);
   EXPECT_NEAR(sim.X_WR().x, 2.0, 1e-3);
   EXPECT_NEAR(sim.X_WR().y, 3.0, 1e-3);
   EXPECT_NEAR(sim.X_WR().theta, DegToRad(-45.0), DegToRad(0.05));

@@ -15,6 +15,7 @@
 
 #include "common/angles.h"
 #include "sim/obstacles.h"
+#include "sim/scene.h"
 #include "sim/simulator.h"
 #include "tests/sim/sim_test_util.h"
 
@@ -51,14 +52,15 @@ TEST_F(WorldsTest, TheRequiredWorldsAreShipped) {
 TEST_F(WorldsTest, EveryWorldLoadsWithAFreeStartAndAClearTour) {
   for (const std::string& world : ShippedWorlds()) {
     SCOPED_TRACE(world);
-    Simulator sim(world, RobotModelPath(), SimParams{}, RobotParams{});
+    const Scene scene(world, RobotModelPath());
+    Simulator sim(scene, SimParams{}, RobotParams{});
     EXPECT_EQ(sim.CountRobotWorldContacts(), 0);
-    const Pose2 start = sim.StartPose();
+    const Pose2 start = scene.StartPose();
     EXPECT_NEAR(sim.X_WR().x, start.x, 1e-3);
     EXPECT_NEAR(sim.X_WR().y, start.y, 1e-3);
 
     // Obstacles: exact shapes, on the floor, taller than the laser.
-    const std::vector<ObstacleFootprint> obstacles = sim.Obstacles();
+    const std::vector<ObstacleFootprint>& obstacles = scene.Obstacles();
     ASSERT_FALSE(obstacles.empty());
     for (const ObstacleFootprint& obstacle : obstacles) {
       EXPECT_TRUE(obstacle.exact) << obstacle.name;
@@ -68,7 +70,7 @@ TEST_F(WorldsTest, EveryWorldLoadsWithAFreeStartAndAClearTour) {
 
     // Tour: at least 3 waypoints, each >= 0.5 m from every obstacle, and so
     // is every point of the closed polyline between them.
-    const std::vector<Eigen::Vector2d> tour = sim.TourWaypoints();
+    const std::vector<Eigen::Vector2d>& tour = scene.TourWaypoints();
     ASSERT_GE(tour.size(), 3u);
     double closest = 1e9;
     for (std::size_t i = 0; i < tour.size(); ++i) {
@@ -97,7 +99,7 @@ TEST_F(WorldsTest, EveryWorldLoadsWithAFreeStartAndAClearTour) {
 // offset a makes its kinematics invertible, Eq. (6)), checking for contacts
 // every 0.1 s. Returns the distance driven by h.
 double DriveTour(Simulator* sim, double speed_mps) {
-  const std::vector<Eigen::Vector2d> tour = sim->TourWaypoints();
+  const std::vector<Eigen::Vector2d>& tour = sim->scene().TourWaypoints();
   const double a = sim->robot().control_point_offset_m;
   std::size_t target = 1;
   std::size_t reached = 0;
