@@ -114,7 +114,7 @@ Lines LinesOf(const LaserScan& scan, const FeatureExtractionParams& params) {
 }
 
 // ---------------------------------------------------------------------------
-// Stage 1: points.
+// Points (step 1).
 
 TEST(ScanPointsTest, DropsNoReturnShortAndNonFiniteBeams) {
   // Beams at 0, 90, 180, 270, 360, 450 degrees.
@@ -152,7 +152,7 @@ TEST(ScanPointsTest, RotatedBeamDirectionsMatchExactOnes) {
 }
 
 // ---------------------------------------------------------------------------
-// Stage 2: clusters.
+// Clusters (step 2).
 
 TEST(FindClustersTest, BreaksAtARangeJump) {
   // Beams -10..-1 deg on the wall x = 2, then 0..10 deg on the wall x = 4.
@@ -192,7 +192,7 @@ TEST(FindClustersTest, BridgesShortGapsAndDropsSmallClusters) {
 }
 
 // ---------------------------------------------------------------------------
-// Stage 3: split.
+// Split (step 3).
 
 TEST(SplitClustersTest, SplitsAtTheVertexAndKeepsStraightClustersWhole) {
   // Cluster 0: an L, (2, -1) .. (2, 0) .. (1, 0), vertex at point 5.
@@ -208,7 +208,7 @@ TEST(SplitClustersTest, SplitsAtTheVertexAndKeepsStraightClustersWhole) {
 }
 
 // ---------------------------------------------------------------------------
-// Stage 4: merge.
+// Merge (step 4).
 
 TEST(MergeRunsTest, MergesStraightNeighboursOfOneClusterOnly) {
   const FeatureExtractionParams params;
@@ -233,7 +233,7 @@ TEST(MergeRunsTest, KeepsTheTwoWallsOfACorner) {
 }
 
 // ---------------------------------------------------------------------------
-// Stage 5: vertex points.
+// Vertex points (step 5).
 
 TEST(SeparateVertexPointsTest, TakesSharedPointsFromBothRuns) {
   std::vector<Segment> runs = {RunOf(0, 5, 0), RunOf(5, 10, 0), RunOf(11, 15, 1), RunOf(15, 20, 2)};
@@ -248,7 +248,7 @@ TEST(SeparateVertexPointsTest, TakesSharedPointsFromBothRuns) {
 }
 
 // ---------------------------------------------------------------------------
-// Stage 6: fit.
+// Fit (steps 5-6).
 
 TEST(FitRunsTest, FitsRunsWithEnoughPoints) {
   const FeatureExtractionParams params;  // min_points 6
@@ -268,7 +268,7 @@ TEST(FitRunsTest, FitsRunsWithEnoughPoints) {
 }
 
 // ---------------------------------------------------------------------------
-// Stage 7: trim.
+// Trim (step 5).
 
 TEST(TrimRunsTest, DropsAnOutlierEnd) {
   const FeatureExtractionParams params;
@@ -317,7 +317,7 @@ TEST(TrimRunsTest, InvalidatesARunTrimmedBelowMinPoints) {
 }
 
 // ---------------------------------------------------------------------------
-// Stage 8: grow.
+// Grow (step 5).
 
 TEST(GrowRunsTest, GrowsIntoFittingPointsUpToVertexPointsAndOutliers) {
   const FeatureExtractionParams params;
@@ -349,7 +349,7 @@ TEST(GrowRunsTest, GrowsIntoFittingPointsUpToVertexPointsAndOutliers) {
 }
 
 // ---------------------------------------------------------------------------
-// Stage 9: keep lines.
+// Keep lines (step 7).
 
 TEST(KeepLinesTest, KeepsLongEnoughValidRunsWithTheirSeenSegments) {
   FeatureExtractionParams params;  // min_length_m 0.25
@@ -378,7 +378,7 @@ TEST(KeepLinesTest, KeepsLongEnoughValidRunsWithTheirSeenSegments) {
 }
 
 // ---------------------------------------------------------------------------
-// Stage 10: corners.
+// Corners (step 8).
 
 // The corners of a scan with the default params, from its two lines.
 std::vector<CornerObservation> CornersOf(const LaserScan& scan) {
