@@ -293,6 +293,17 @@ const Segment* ValidAfter(const std::vector<Segment>& runs, std::size_t i) {
   return nullptr;
 }
 
+// Calls visit(run, before, after) for each valid run in order, with its
+// nearest valid neighbours in its cluster when it comes up (null: none).
+template <typename Visit>
+void ForEachValidRun(std::vector<Segment>* runs, Visit visit) {
+  for (std::size_t i = 0; i < runs->size(); ++i) {
+    Segment& run = (*runs)[i];
+    if (!run.valid) continue;
+    visit(run, ValidBefore(*runs, i), ValidAfter(*runs, i));
+  }
+}
+
 // Refits a run whose points changed by one, from its previous fit; it stays
 // valid with at least `min_points` points and a fit.
 void Refit(const std::vector<ScanPoint>& points, const NoiseModel& noise, int min_points,
@@ -457,16 +468,11 @@ void FitRuns(const std::vector<ScanPoint>& points, const NoiseModel& noise, int 
 }
 
 void TrimRuns(const std::vector<ScanPoint>& points, const NoiseModel& noise,
-              const FeatureExtractionParams& params, std::vector<Segment>* runs_in) {
+              const FeatureExtractionParams& params, std::vector<Segment>* runs) {
   // Outliers of their own line, and points near a vertex that fit the
   // neighbouring line of the same cluster too; refit after each.
-  std::vector<Segment>& runs = *runs_in;
   const double gate = params.outlier_gate_sigmas;
-  for (std::size_t i = 0; i < runs.size(); ++i) {
-    Segment& run = runs[i];
-    if (!run.valid) continue;
-    const Segment* before = ValidBefore(runs, i);
-    const Segment* after = ValidAfter(runs, i);
+  ForEachValidRun(runs, [&](Segment& run, const Segment* before, const Segment* after) {
     bool changed = true;
     while (changed && run.valid) {
       changed = false;
@@ -480,22 +486,17 @@ void TrimRuns(const std::vector<ScanPoint>& points, const NoiseModel& noise,
       }
       if (changed) Refit(points, noise, params.min_points, &run);
     }
-  }
+  });
 }
 
 void GrowRuns(const std::vector<ScanPoint>& points, const NoiseModel& noise,
               const FeatureExtractionParams& params, const std::vector<ClusterBounds>& clusters,
-              const std::vector<char>& is_vertex, std::vector<Segment>* runs_in) {
+              const std::vector<char>& is_vertex, std::vector<Segment>* runs) {
   // Into points that no line holds (points trimmed before, runs too short to
   // be lines; never a vertex point): a point joins when it fits the line
   // within the gate and does not fit the neighbouring line (not ambiguous).
-  std::vector<Segment>& runs = *runs_in;
   const double gate = params.outlier_gate_sigmas;
-  for (std::size_t i = 0; i < runs.size(); ++i) {
-    Segment& run = runs[i];
-    if (!run.valid) continue;
-    const Segment* before = ValidBefore(runs, i);
-    const Segment* after = ValidAfter(runs, i);
+  ForEachValidRun(runs, [&](Segment& run, const Segment* before, const Segment* after) {
     const int lowest = before != nullptr ? before->last + 1 : clusters[run.cluster].first;
     const int highest = after != nullptr ? after->first - 1 : clusters[run.cluster].last;
     while (run.valid && run.first > lowest && is_vertex[run.first - 1] == 0 &&
@@ -508,7 +509,7 @@ void GrowRuns(const std::vector<ScanPoint>& points, const NoiseModel& noise,
       ++run.last;
       Refit(points, noise, params.min_points, &run);
     }
-  }
+  });
 }
 
 std::vector<LineObservation> KeepLines(const std::vector<ScanPoint>& points,

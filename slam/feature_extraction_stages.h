@@ -1,7 +1,8 @@
 #pragma once
 
 // The stages of ExtractFeatures (slam/README.md, "Feature extraction",
-// steps 1-8), in pipeline order, with the types they pass along. Exposed so
+// steps 1-8, cited as "step N" below), in pipeline order, with the types
+// they pass along. Exposed so
 // that each stage is tested on its own (tests/slam/feature_extraction_stages_test.cc);
 // the filter and the application use ExtractFeatures only.
 
@@ -36,8 +37,8 @@ struct NoiseModel {
 struct LineFit {
   double rho = 0.0;    ///< metres, >= 0
   double alpha = 0.0;  ///< radians, in (-pi, pi]
-  double cos_alpha = 1.0;
-  double sin_alpha = 0.0;
+  double cos_alpha = 1.0;  ///< cos(alpha), kept for the residuals
+  double sin_alpha = 0.0;  ///< sin(alpha)
   /// Covariance of (rho, alpha) from the beam noise alone (no floors).
   Eigen::Matrix2d covariance = Eigen::Matrix2d::Zero();
   /// False when the points define no line (too few, or degenerate).
@@ -82,13 +83,13 @@ double PerpendicularVariance(const ScanPoint& p, double cos_alpha, double sin_al
 LineFit FitLine(const std::vector<ScanPoint>& points, int first, int last,
                 const NoiseModel& noise, const LineFit* prior = nullptr);
 
-/// Stage 1, points: the returned beams of `scan` as points in S, in beam
+/// Points (README step 1): the returned beams of `scan` as points in S, in beam
 /// order. No-return beams (also those past the end of `has_return`) and
 /// ranges that are not in (1 mm, 10 km) are dropped. Precondition: the
 /// increment and `angle_min_rad` are finite (ExtractFeatures checks).
 std::vector<ScanPoint> ScanPoints(const LaserScan& scan);
 
-/// Stage 2, clusters: consecutive points stay in one cluster while they are
+/// Clusters (step 2): consecutive points stay in one cluster while they are
 /// within the adaptive breakpoint distance (Borges & Aldon 2004) and at most
 /// `max_missing_beams` beams are missing between them; `increment_rad` is the
 /// scan's beam increment. Clusters of fewer than `min_points` points are left
@@ -97,7 +98,7 @@ std::vector<ClusterBounds> FindClusters(const std::vector<ScanPoint>& points,
                                         double increment_rad,
                                         const FeatureExtractionParams& params);
 
-/// Stage 3, split: each cluster is split recursively at its point farthest
+/// Split (step 3): each cluster is split recursively at its point farthest
 /// from the chord between its ends while that point is farther than
 /// `split_distance_m` (iterative end-point fit). Neighbouring runs share their
 /// split point. Returns the runs of all clusters in order, `cluster` set to
@@ -106,23 +107,23 @@ std::vector<Segment> SplitClusters(const std::vector<ScanPoint>& points,
                                    const std::vector<ClusterBounds>& clusters,
                                    double split_distance_m);
 
-/// Stage 4, merge: neighbouring runs of one cluster that share their boundary
+/// Merge (step 4): neighbouring runs of one cluster that share their boundary
 /// point and whose union's fitted line lies within `split_distance_m` of all
 /// its points become one run, the straightest union first.
 void MergeRuns(const std::vector<ScanPoint>& points, const NoiseModel& noise,
                double split_distance_m, std::vector<Segment>* runs);
 
-/// Stage 5, vertex points: a point shared by two neighbouring runs of one
+/// Vertex points (step 5): a point shared by two neighbouring runs of one
 /// cluster (a split point, nearest the vertex) is taken from both. Returns,
 /// per point of the `point_count`, 1 for such a vertex point, else 0.
 std::vector<char> SeparateVertexPoints(int point_count, std::vector<Segment>* runs);
 
-/// Stage 6, fit: every run with at least `min_points` points gets its line
+/// Fit (steps 5-6): every run with at least `min_points` points gets its line
 /// fit; `valid` says whether it has one.
 void FitRuns(const std::vector<ScanPoint>& points, const NoiseModel& noise, int min_points,
              std::vector<Segment>* runs);
 
-/// Stage 7, trim: while the first or last point of a valid run is an outlier
+/// Trim (step 5): while the first or last point of a valid run is an outlier
 /// of its line (more than `outlier_gate_sigmas` deviations) or within the gate
 /// of the neighbouring valid run of its cluster too (ambiguous), it is
 /// dropped and the run refitted; a run left with fewer than `min_points`
@@ -130,7 +131,7 @@ void FitRuns(const std::vector<ScanPoint>& points, const NoiseModel& noise, int 
 void TrimRuns(const std::vector<ScanPoint>& points, const NoiseModel& noise,
               const FeatureExtractionParams& params, std::vector<Segment>* runs);
 
-/// Stage 8, grow: each valid run grows at both ends into the points between
+/// Grow (step 5): each valid run grows at both ends into the points between
 /// it and its valid neighbour (or its cluster's end) that fit its line within
 /// the gate and do not fit the neighbour's, never into a vertex point
 /// (`is_vertex` from SeparateVertexPoints); refitted after each point.
@@ -138,7 +139,7 @@ void GrowRuns(const std::vector<ScanPoint>& points, const NoiseModel& noise,
               const FeatureExtractionParams& params, const std::vector<ClusterBounds>& clusters,
               const std::vector<char>& is_vertex, std::vector<Segment>* runs);
 
-/// Stage 9, keep lines: each valid run whose seen segment is at least
+/// Keep lines (step 7): each valid run whose seen segment is at least
 /// `min_length_m` long becomes a line (with the model-error floor on its
 /// covariance); the others become invalid. `line_of_run` receives, per run,
 /// the index of its line or -1.
@@ -159,7 +160,7 @@ std::optional<CornerObservation> CornerBetween(const std::vector<ScanPoint>& poi
                                                const LineObservation& line_a,
                                                const LineObservation& line_b);
 
-/// Stage 10, corners: CornerBetween for every two consecutive valid runs of
+/// Corners (step 8): CornerBetween for every two consecutive valid runs of
 /// one cluster, in order, with the indices of their lines into `lines`.
 std::vector<CornerObservation> FindCorners(const std::vector<ScanPoint>& points,
                                            const NoiseModel& noise,

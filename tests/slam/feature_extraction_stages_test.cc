@@ -4,6 +4,7 @@
 
 #include "slam/feature_extraction_stages.h"
 
+#include <array>
 #include <cmath>
 #include <limits>
 #include <vector>
@@ -45,6 +46,9 @@ Segment RunOf(int first, int last, int cluster) {
   run.cluster = cluster;
   return run;
 }
+
+// (first, last, cluster) of a run.
+std::array<int, 3> Bounds(const Segment& run) { return {run.first, run.last, run.cluster}; }
 
 // A scan with every beam returning, from `angle_min_deg`, 1 degree apart.
 LaserScan Scan(const std::vector<double>& ranges_m, double angle_min_deg) {
@@ -110,7 +114,7 @@ Lines LinesOf(const LaserScan& scan, const FeatureExtractionParams& params) {
 }
 
 // ---------------------------------------------------------------------------
-// Stage 1: points.
+// Points (step 1).
 
 TEST(ScanPointsTest, DropsNoReturnShortAndNonFiniteBeams) {
   // Beams at 0, 90, 180, 270, 360, 450 degrees.
@@ -148,7 +152,7 @@ TEST(ScanPointsTest, RotatedBeamDirectionsMatchExactOnes) {
 }
 
 // ---------------------------------------------------------------------------
-// Stage 2: clusters.
+// Clusters (step 2).
 
 TEST(FindClustersTest, BreaksAtARangeJump) {
   // Beams -10..-1 deg on the wall x = 2, then 0..10 deg on the wall x = 4.
@@ -188,7 +192,7 @@ TEST(FindClustersTest, BridgesShortGapsAndDropsSmallClusters) {
 }
 
 // ---------------------------------------------------------------------------
-// Stage 3: split.
+// Split (step 3).
 
 TEST(SplitClustersTest, SplitsAtTheVertexAndKeepsStraightClustersWhole) {
   // Cluster 0: an L, (2, -1) .. (2, 0) .. (1, 0), vertex at point 5.
@@ -198,19 +202,13 @@ TEST(SplitClustersTest, SplitsAtTheVertexAndKeepsStraightClustersWhole) {
   Append(PointsAlong(3.0, 1.0, 0.0, 0.1, 10, 11), &points);
   const std::vector<Segment> runs = SplitClusters(points, {{0, 10}, {11, 20}}, 0.03);
   ASSERT_EQ(runs.size(), 3u);
-  EXPECT_EQ(runs[0].first, 0);
-  EXPECT_EQ(runs[0].last, 5);
-  EXPECT_EQ(runs[1].first, 5);
-  EXPECT_EQ(runs[1].last, 10);
-  EXPECT_EQ(runs[2].first, 11);
-  EXPECT_EQ(runs[2].last, 20);
-  EXPECT_EQ(runs[0].cluster, 0);
-  EXPECT_EQ(runs[1].cluster, 0);
-  EXPECT_EQ(runs[2].cluster, 1);
+  EXPECT_EQ(Bounds(runs[0]), (std::array<int, 3>{0, 5, 0}));
+  EXPECT_EQ(Bounds(runs[1]), (std::array<int, 3>{5, 10, 0}));
+  EXPECT_EQ(Bounds(runs[2]), (std::array<int, 3>{11, 20, 1}));
 }
 
 // ---------------------------------------------------------------------------
-// Stage 4: merge.
+// Merge (step 4).
 
 TEST(MergeRunsTest, MergesStraightNeighboursOfOneClusterOnly) {
   const FeatureExtractionParams params;
@@ -221,10 +219,8 @@ TEST(MergeRunsTest, MergesStraightNeighboursOfOneClusterOnly) {
   std::vector<Segment> runs = {RunOf(0, 5, 0), RunOf(5, 10, 0), RunOf(10, 15, 0), RunOf(15, 20, 1)};
   MergeRuns(points, noise, params.split_distance_m, &runs);
   ASSERT_EQ(runs.size(), 2u);
-  EXPECT_EQ(runs[0].first, 0);
-  EXPECT_EQ(runs[0].last, 15);
-  EXPECT_EQ(runs[1].first, 15);
-  EXPECT_EQ(runs[1].cluster, 1);
+  EXPECT_EQ(Bounds(runs[0]), (std::array<int, 3>{0, 15, 0}));
+  EXPECT_EQ(Bounds(runs[1]), (std::array<int, 3>{15, 20, 1}));
 }
 
 TEST(MergeRunsTest, KeepsTheTwoWallsOfACorner) {
@@ -237,7 +233,7 @@ TEST(MergeRunsTest, KeepsTheTwoWallsOfACorner) {
 }
 
 // ---------------------------------------------------------------------------
-// Stage 5: vertex points.
+// Vertex points (step 5).
 
 TEST(SeparateVertexPointsTest, TakesSharedPointsFromBothRuns) {
   std::vector<Segment> runs = {RunOf(0, 5, 0), RunOf(5, 10, 0), RunOf(11, 15, 1), RunOf(15, 20, 2)};
@@ -252,7 +248,7 @@ TEST(SeparateVertexPointsTest, TakesSharedPointsFromBothRuns) {
 }
 
 // ---------------------------------------------------------------------------
-// Stage 6: fit.
+// Fit (steps 5-6).
 
 TEST(FitRunsTest, FitsRunsWithEnoughPoints) {
   const FeatureExtractionParams params;  // min_points 6
@@ -272,7 +268,7 @@ TEST(FitRunsTest, FitsRunsWithEnoughPoints) {
 }
 
 // ---------------------------------------------------------------------------
-// Stage 7: trim.
+// Trim (step 5).
 
 TEST(TrimRunsTest, DropsAnOutlierEnd) {
   const FeatureExtractionParams params;
@@ -321,7 +317,7 @@ TEST(TrimRunsTest, InvalidatesARunTrimmedBelowMinPoints) {
 }
 
 // ---------------------------------------------------------------------------
-// Stage 8: grow.
+// Grow (step 5).
 
 TEST(GrowRunsTest, GrowsIntoFittingPointsUpToVertexPointsAndOutliers) {
   const FeatureExtractionParams params;
@@ -353,7 +349,7 @@ TEST(GrowRunsTest, GrowsIntoFittingPointsUpToVertexPointsAndOutliers) {
 }
 
 // ---------------------------------------------------------------------------
-// Stage 9: keep lines.
+// Keep lines (step 7).
 
 TEST(KeepLinesTest, KeepsLongEnoughValidRunsWithTheirSeenSegments) {
   FeatureExtractionParams params;  // min_length_m 0.25
@@ -382,16 +378,19 @@ TEST(KeepLinesTest, KeepsLongEnoughValidRunsWithTheirSeenSegments) {
 }
 
 // ---------------------------------------------------------------------------
-// Stage 10: corners.
+// Corners (step 8).
+
+// The corners of a scan with the default params, from its two lines.
+std::vector<CornerObservation> CornersOf(const LaserScan& scan) {
+  const FeatureExtractionParams params;
+  const Lines found = LinesOf(scan, params);
+  EXPECT_EQ(found.lines.size(), 2u);
+  return FindCorners(found.points, MakeNoiseModel(params), params, scan.angle_increment_rad,
+                     found.runs, found.line_of_run, found.lines);
+}
 
 TEST(FindCornersTest, FindsAConcaveCornerAtTheVertex) {
-  const FeatureExtractionParams params;
-  const LaserScan scan = ConcaveCornerScan();
-  const Lines found = LinesOf(scan, params);
-  ASSERT_EQ(found.lines.size(), 2u);
-  const std::vector<CornerObservation> corners =
-      FindCorners(found.points, MakeNoiseModel(params), params, scan.angle_increment_rad,
-                  found.runs, found.line_of_run, found.lines);
+  const std::vector<CornerObservation> corners = CornersOf(ConcaveCornerScan());
   ASSERT_EQ(corners.size(), 1u);
   EXPECT_EQ(corners[0].kind, CornerKind::kConcave);
   EXPECT_NEAR(corners[0].p_SC.x(), 2.0, 1e-6);
@@ -404,87 +403,93 @@ TEST(FindCornersTest, FindsAConcaveCornerAtTheVertex) {
 }
 
 TEST(FindCornersTest, FindsAConvexCornerPointingAtTheSensor) {
-  const FeatureExtractionParams params;
-  const LaserScan scan = ConvexCornerScan();
-  const Lines found = LinesOf(scan, params);
-  ASSERT_EQ(found.lines.size(), 2u);
-  const std::vector<CornerObservation> corners =
-      FindCorners(found.points, MakeNoiseModel(params), params, scan.angle_increment_rad,
-                  found.runs, found.line_of_run, found.lines);
+  const std::vector<CornerObservation> corners = CornersOf(ConvexCornerScan());
   ASSERT_EQ(corners.size(), 1u);
   EXPECT_EQ(corners[0].kind, CornerKind::kConvex);
   EXPECT_NEAR(corners[0].p_SC.x(), 2.0, 1e-6);
   EXPECT_NEAR(corners[0].p_SC.y(), 0.0, 1e-6);
 }
 
+// The first two runs of a scan with their lines (default params), and
+// whether CornerBetween makes them a corner.
+struct LinePair {
+  FeatureExtractionParams params;
+  double increment_rad = 0.0;
+  std::vector<ScanPoint> points;
+  Segment run_a;
+  Segment run_b;
+  LineObservation line_a;
+  LineObservation line_b;
+
+  bool IsCorner() const {
+    return CornerBetween(points, MakeNoiseModel(params), params, increment_rad, run_a, run_b,
+                         line_a, line_b)
+        .has_value();
+  }
+};
+
+LinePair FirstPair(const LaserScan& scan) {
+  LinePair pair;
+  const Lines found = LinesOf(scan, pair.params);
+  EXPECT_EQ(found.lines.size(), 2u);
+  EXPECT_EQ(found.runs.size(), 2u);
+  pair.increment_rad = scan.angle_increment_rad;
+  pair.points = found.points;
+  pair.run_a = found.runs.at(0);
+  pair.run_b = found.runs.at(1);
+  pair.line_a = found.lines.at(0);
+  pair.line_b = found.lines.at(1);
+  return pair;
+}
+
 TEST(CornerBetweenTest, RejectsLinesThatEndFarFromTheirIntersection) {
   // The concave corner with the beams of wall x = 2 above y = 0.45 lost:
   // wall a stops 0.55 m short of the vertex (an occlusion edge, not a
   // corner), and the gap splits the clusters.
-  const FeatureExtractionParams params;
   LaserScan scan = ConcaveCornerScan();
   for (int i = 0; i < scan.size(); ++i) {
     const double phi = scan.BeamAngle(i);
     if (std::tan(phi) <= 0.5 && std::tan(phi) > 0.225) scan.has_return[i] = 0;
   }
+  const FeatureExtractionParams params;
   const Lines found = LinesOf(scan, params);
-  ASSERT_EQ(found.lines.size(), 2u);
   ASSERT_EQ(found.runs.size(), 2u);
   EXPECT_NE(found.runs[0].cluster, found.runs[1].cluster);
-  const NoiseModel noise = MakeNoiseModel(params);
-  EXPECT_FALSE(CornerBetween(found.points, noise, params, scan.angle_increment_rad,
-                             found.runs[0], found.runs[1], found.lines[0], found.lines[1]));
-  EXPECT_TRUE(FindCorners(found.points, noise, params, scan.angle_increment_rad, found.runs,
-                          found.line_of_run, found.lines)
+  EXPECT_TRUE(FindCorners(found.points, MakeNoiseModel(params), params, scan.angle_increment_rad,
+                          found.runs, found.line_of_run, found.lines)
                   .empty());
+  LinePair pair = FirstPair(scan);
+  EXPECT_FALSE(pair.IsCorner());
   // With the tolerance widened past the gap, the same pair is a corner.
-  FeatureExtractionParams wide = params;
-  wide.corner_max_endpoint_distance_m = 0.6;
-  EXPECT_TRUE(CornerBetween(found.points, noise, wide, scan.angle_increment_rad, found.runs[0],
-                            found.runs[1], found.lines[0], found.lines[1]));
+  pair.params.corner_max_endpoint_distance_m = 0.6;
+  EXPECT_TRUE(pair.IsCorner());
 }
 
 TEST(CornerBetweenTest, RejectsPointsBetweenTheLinesBehindTheirLine) {
   // The concave corner with the last 3 points of wall a (x = 2) taken from
   // its run: on the wall they pass; 10 cm behind it (as where a box face
   // ends in front of a wall) they make the pair an occlusion edge.
-  const FeatureExtractionParams params;
-  const LaserScan scan = ConcaveCornerScan();
-  const Lines found = LinesOf(scan, params);
-  ASSERT_EQ(found.lines.size(), 2u);
-  const NoiseModel noise = MakeNoiseModel(params);
-  Segment run_a = found.runs[0];
-  run_a.last -= 3;
-  std::vector<ScanPoint> points = found.points;
-  EXPECT_TRUE(CornerBetween(points, noise, params, scan.angle_increment_rad, run_a,
-                            found.runs[1], found.lines[0], found.lines[1]));
-  for (int i = run_a.last + 1; i <= run_a.last + 3; ++i) {
-    points[i] = Point(points[i].x + 0.1, points[i].y, points[i].beam);
+  LinePair pair = FirstPair(ConcaveCornerScan());
+  pair.run_a.last -= 3;
+  EXPECT_TRUE(pair.IsCorner());
+  for (int i = pair.run_a.last + 1; i <= pair.run_a.last + 3; ++i) {
+    const ScanPoint p = pair.points[i];
+    pair.points[i] = Point(p.x + 0.1, p.y, p.beam);
   }
-  EXPECT_FALSE(CornerBetween(points, noise, params, scan.angle_increment_rad, run_a,
-                             found.runs[1], found.lines[0], found.lines[1]));
+  EXPECT_FALSE(pair.IsCorner());
 }
 
 TEST(CornerBetweenTest, RejectsLinesAtTooSmallAnAngle) {
-  const FeatureExtractionParams params;
-  const LaserScan scan = ConcaveCornerScan();
-  const Lines found = LinesOf(scan, params);
-  ASSERT_EQ(found.lines.size(), 2u);
-  const NoiseModel noise = MakeNoiseModel(params);
-  ASSERT_TRUE(CornerBetween(found.points, noise, params, scan.angle_increment_rad, found.runs[0],
-                            found.runs[1], found.lines[0], found.lines[1]));
-  // The same pair with line b turned about the vertex (2, 1) to 20 degrees
-  // from line a (x = 2): everything else still passes, but the smallest
-  // angle allowed is corner_min_angle_deg, 30.
-  LineObservation turned = found.lines[1];
-  turned.alpha_rad = DegToRad(20.0);
-  turned.rho_m = 2.0 * std::cos(turned.alpha_rad) + 1.0 * std::sin(turned.alpha_rad);
-  FeatureExtractionParams small_angle = params;
-  small_angle.corner_min_angle_deg = 15.0;
-  EXPECT_TRUE(CornerBetween(found.points, noise, small_angle, scan.angle_increment_rad,
-                            found.runs[0], found.runs[1], found.lines[0], turned));
-  EXPECT_FALSE(CornerBetween(found.points, noise, params, scan.angle_increment_rad,
-                             found.runs[0], found.runs[1], found.lines[0], turned));
+  LinePair pair = FirstPair(ConcaveCornerScan());
+  ASSERT_TRUE(pair.IsCorner());
+  // Line b turned about the vertex (2, 1) to 20 degrees from line a (x = 2):
+  // everything else still passes, but the smallest angle allowed is
+  // corner_min_angle_deg, 30.
+  pair.line_b.alpha_rad = DegToRad(20.0);
+  pair.line_b.rho_m = 2.0 * std::cos(pair.line_b.alpha_rad) + 1.0 * std::sin(pair.line_b.alpha_rad);
+  EXPECT_FALSE(pair.IsCorner());
+  pair.params.corner_min_angle_deg = 15.0;
+  EXPECT_TRUE(pair.IsCorner());
 }
 
 }  // namespace
