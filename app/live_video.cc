@@ -3,8 +3,8 @@
 #include <algorithm>
 #include <chrono>
 
-#include "app/map_csv.h"
 #include "app/scene_frame.h"
+#include "app/slam_pair.h"
 
 namespace mjslam::app {
 LiveVideo::LiveVideo(const RunConfig& config, const std::string& run_dir)

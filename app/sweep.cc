@@ -19,11 +19,14 @@
 #include <stdexcept>
 #include <thread>
 
-#include "app/csv_reader.h"
-#include "app/csv_writer.h"
-#include "app/run_files.h"
 #include "config/config.h"
 #include "eval/chi_square.h"
+#include "rundir/csv_reader.h"
+#include "rundir/csv_writer.h"
+#include "rundir/layout.h"
+#include "rundir/manifest.h"
+#include "rundir/run_files.h"
+#include "rundir/summary.h"
 
 extern char** environ;
 
@@ -31,6 +34,11 @@ namespace mjslam::app {
 namespace {
 
 namespace fs = std::filesystem;
+using rundir::CsvTable;
+using rundir::FilterNames;
+using rundir::FormatDouble;
+using rundir::PathIn;
+using rundir::ReadJsonFile;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
 std::string RunName(int index) {
@@ -71,8 +79,8 @@ bool Completed(const std::string& dir, bool* evaluated) {
   nlohmann::json manifest;
   nlohmann::json summary;
   try {
-    manifest = ReadJsonFile(dir + "/manifest.json", nullptr);
-    summary = ReadJsonFile(dir + "/summary.json", nullptr);
+    manifest = ReadJsonFile(PathIn(dir, rundir::kManifestFile), nullptr);
+    summary = ReadJsonFile(PathIn(dir, rundir::kSummaryFile), nullptr);
   } catch (const std::runtime_error&) {
     return false;  // a file cut short: redo the run
   }
@@ -80,7 +88,7 @@ bool Completed(const std::string& dir, bool* evaluated) {
   *evaluated = summary.is_object() && summary.contains("filters") &&
                summary["filters"].contains("selective") &&
                summary["filters"]["selective"].contains("mean_nees") &&
-               fs::exists(dir + "/ground_truth_map.csv");
+               fs::exists(PathIn(dir, rundir::kGroundTruthMapFile));
   return true;
 }
 
@@ -99,10 +107,19 @@ nlohmann::json MeanOf(const std::vector<nlohmann::json>& summaries, const nlohma
   return count > 0 ? nlohmann::json(sum / count) : nlohmann::json(nullptr);
 }
 
-}  // namespace
+// What a run of the sweep needs next.
+enum class Stage { kRun, kEvaluate };
 
-SweepResult RunSweep(const RunConfig& config, const SweepOptions& options) {
-  config.ValidateOrThrow();
+// One run of the sweep in the process pool.
+struct Job {
+  int index;
+  std::string dir;
+  Stage stage;
+  pid_t pid = -1;
+};
+
+// Checks the options; returns the number of runs at a time.
+int CheckedJobs(const SweepOptions& options) {
   if (options.runs < 1) throw std::runtime_error("sweep: --runs must be >= 1 (got " + std::to_string(options.runs) + ")");
   if (options.jobs < 0) throw std::runtime_error("sweep: --jobs must be >= 0 (got " + std::to_string(options.jobs) + ")");
   const int jobs = options.jobs > 0 ? options.jobs
@@ -111,72 +128,81 @@ SweepResult RunSweep(const RunConfig& config, const SweepOptions& options) {
   if (!fs::is_regular_file(options.program)) {
     throw std::runtime_error("sweep: program not found: '" + options.program + "'");
   }
-  const std::string dir = options.out_dir;
-  MakeRunDirectory(dir);
-  MakeRunDirectory(dir + "/runs");
+  return jobs;
+}
 
-  // One config per sweep directory: a resumed sweep must be the same sweep.
-  const std::string config_path = dir + "/config.yaml";
+// Makes the sweep directory and writes its config.yaml; returns its path.
+// One config per sweep directory: a resumed sweep must be the same sweep.
+std::string PrepareSweepDirectory(const RunConfig& config, const std::string& dir) {
+  rundir::MakeRunDirectory(dir);
+  rundir::MakeRunDirectory(PathIn(dir, rundir::kSweepRunsFolder));
+  const std::string config_path = PathIn(dir, rundir::kConfigFile);
   const std::string config_text = config::ToYaml(config);
   if (fs::exists(config_path) && ReadText(config_path) != config_text) {
     throw std::runtime_error(config_path +
                              ": this sweep directory was made with another config; use the same "
                              "config and --set options to resume it, or another --out");
   }
-  WriteFileAtomically(config_path, config_text);
+  rundir::WriteFileAtomically(config_path, config_text);
+  return config_path;
+}
 
-  // What each run needs: 0 run and evaluate, 1 evaluate only, 2 nothing.
-  struct Job {
-    int index;
-    std::string dir;
-    int stage;
-    pid_t pid = -1;
-  };
+// The work left: a completed run is kept (and evaluated if its summary lacks
+// the metrics); any other is deleted and redone.
+std::deque<Job> PlanJobs(const std::vector<std::string>& run_dirs, const SweepOptions& options,
+                         SweepResult* result) {
   std::deque<Job> pending;
-  SweepResult result;
-  std::vector<std::string> run_dirs;
-  for (int i = 0; i < options.runs; ++i) {
-    const std::string run_dir = dir + "/runs/" + RunName(i);
-    run_dirs.push_back(run_dir);
+  for (int i = 0; i < static_cast<int>(run_dirs.size()); ++i) {
+    const std::string& run_dir = run_dirs[i];
     bool evaluated = false;
     if (Completed(run_dir, &evaluated)) {
-      ++result.runs_kept;
-      if (!evaluated && options.evaluate_runs) pending.push_back({i, run_dir, 1});
+      ++result->runs_kept;
+      if (!evaluated && options.evaluate_runs) pending.push_back({i, run_dir, Stage::kEvaluate});
       continue;
     }
     fs::remove_all(run_dir);
     fs::remove(run_dir + ".log");
-    pending.push_back({i, run_dir, 0});
+    pending.push_back({i, run_dir, Stage::kRun});
   }
+  return pending;
+}
 
-  auto start = [&](Job* job) {
-    const std::uint64_t seed = config.run.seed + static_cast<std::uint64_t>(job->index);
-    if (job->stage == 0) {
-      job->pid = Spawn({options.program, "run", "--quiet", "--no-render", "--no-evaluate",
-                        "--config", config_path, "--seed",
-                        std::to_string(seed), "--out", job->dir},
-                       job->dir + ".log");
-    } else {
-      job->pid = Spawn({options.program, "evaluate", job->dir, "--divergence-points",
-                        std::to_string(options.divergence_points)},
-                       job->dir + ".log");
-    }
-  };
+// Starts the process of `job`'s stage: `mjslam run` or `mjslam evaluate`.
+void StartJob(const RunConfig& config, const std::string& config_path, const SweepOptions& options,
+              Job* job) {
+  const std::uint64_t seed = config.run.seed + static_cast<std::uint64_t>(job->index);
+  if (job->stage == Stage::kRun) {
+    job->pid = Spawn({options.program, "run", "--quiet", "--no-render", "--no-evaluate",
+                      "--config", config_path, "--seed",
+                      std::to_string(seed), "--out", job->dir},
+                     job->dir + ".log");
+  } else {
+    job->pid = Spawn({options.program, "evaluate", job->dir, "--divergence-points",
+                      std::to_string(options.divergence_points)},
+                     job->dir + ".log");
+  }
+}
+
+// Runs `pending`, `jobs` processes at a time; a run that succeeds is then
+// evaluated. Returns the failures; sets result->interrupted (and stops the
+// running processes) when a stop is requested.
+std::vector<std::string> RunJobs(std::deque<Job> pending, int jobs, const RunConfig& config,
+                                 const std::string& config_path, const SweepOptions& options,
+                                 SweepResult* result) {
   std::vector<Job> active;
   std::vector<std::string> failures;
   while (!pending.empty() || !active.empty()) {
-    const bool stop = options.stop_requested != nullptr && *options.stop_requested != 0;
-    if (stop) {
+    if (options.stop_requested != nullptr && *options.stop_requested != 0) {
       // Stop the running ones; the next sweep redoes them.
       for (const Job& job : active) ::kill(job.pid, SIGTERM);
       for (const Job& job : active) ::waitpid(job.pid, nullptr, 0);
-      result.interrupted = true;
-      return result;
+      result->interrupted = true;
+      return failures;
     }
     while (static_cast<int>(active.size()) < jobs && !pending.empty()) {
       Job job = pending.front();
       pending.pop_front();
-      start(&job);
+      StartJob(config, config_path, options, &job);
       active.push_back(job);
     }
     int status = 0;
@@ -191,37 +217,59 @@ SweepResult RunSweep(const RunConfig& config, const SweepOptions& options) {
       active.erase(active.begin() + static_cast<std::ptrdiff_t>(k));
       const bool ok = WIFEXITED(status) && WEXITSTATUS(status) == 0;
       if (!ok) {
-        ++result.runs_failed;
-        failures.push_back(job.dir + (job.stage == 0 ? ": run" : ": evaluate") +
+        ++result->runs_failed;
+        failures.push_back(job.dir + (job.stage == Stage::kRun ? ": run" : ": evaluate") +
                            " failed, see " + job.dir + ".log");
-      } else if (job.stage == 0 && options.evaluate_runs) {
-        job.stage = 1;
-        start(&job);
+      } else if (job.stage == Stage::kRun && options.evaluate_runs) {
+        job.stage = Stage::kEvaluate;
+        StartJob(config, config_path, options, &job);
         active.push_back(job);
-        ++result.runs_made;
-      } else if (job.stage == 0) {
-        ++result.runs_made;
+        ++result->runs_made;
+      } else if (job.stage == Stage::kRun) {
+        ++result->runs_made;
       } else if (options.verbose) {
         std::fprintf(stderr, "%s: done\n", job.dir.c_str());
       }
       break;
     }
   }
+  return failures;
+}
+
+}  // namespace
+
+SweepResult RunSweep(const RunConfig& config, const SweepOptions& options) {
+  config.ValidateOrThrow();
+  const int jobs = CheckedJobs(options);
+  const std::string& dir = options.out_dir;
+  const std::string config_path = PrepareSweepDirectory(config, dir);
+  std::vector<std::string> run_dirs;
+  for (int i = 0; i < options.runs; ++i) {
+    run_dirs.push_back(PathIn(PathIn(dir, rundir::kSweepRunsFolder), RunName(i)));
+  }
+
+  // Run and evaluate what is missing, J processes at a time.
+  SweepResult result;
+  const std::vector<std::string> failures =
+      RunJobs(PlanJobs(run_dirs, options, &result), jobs, config, config_path, options, &result);
+  if (result.interrupted) return result;
   if (!failures.empty()) {
     std::string message = "sweep: " + std::to_string(failures.size()) + " of " +
                           std::to_string(options.runs) + " runs failed:";
     for (const std::string& f : failures) message += "\n  " + f;
     throw std::runtime_error(message);
   }
+
+  // The aggregate, and the divergence study of the first run.
   result.summary = AggregateSweep(run_dirs, dir, options);
   result.summary["sweep"]["runs_made"] = result.runs_made;
   result.summary["sweep"]["runs_kept"] = result.runs_kept;
   result.summary["sweep"]["base_seed"] = config.run.seed;
   result.summary["sweep"]["jobs"] = jobs;
-  WriteJsonAtomically(dir + "/summary.json", result.summary);
+  rundir::WriteSummary(dir, result.summary);
   if (!options.divergence_study_points.empty()) {
     WriteDivergenceStudy(run_dirs.front(), options.divergence_study_points,
-                         options.divergence_study_realisations, dir + "/divergence.csv");
+                         options.divergence_study_realisations, PathIn(dir, rundir::kDivergenceFile));
   }
   return result;
 }
@@ -237,7 +285,7 @@ nlohmann::json AggregateSweep(const std::vector<std::string>& run_dirs, const st
   std::vector<std::vector<double>> max_period_s(names.size());
   std::vector<nlohmann::json> summaries;
   for (const std::string& run_dir : run_dirs) {
-    const CsvTable table = ReadCsv(run_dir + "/trajectory.csv");
+    const CsvTable table = rundir::ReadCsv(PathIn(run_dir, rundir::kTrajectoryFile));
     const int t = table.ColumnIndex("t");
     std::vector<double> run_times;
     for (const std::vector<double>& row : table.rows) run_times.push_back(row[t]);
@@ -259,14 +307,14 @@ nlohmann::json AggregateSweep(const std::vector<std::string>& run_dirs, const st
         max_period_s[f].push_back(longest);
       }
     }
-    summaries.push_back(ReadJsonFile(run_dir + "/summary.json", nlohmann::json::object()));
+    summaries.push_back(ReadJsonFile(PathIn(run_dir, rundir::kSummaryFile), nlohmann::json::object()));
   }
 
   // Per step: average NEES over the runs that reach it, when every such run
   // has both filters' NEES (the known start has none).
   std::size_t num_steps = 0;
   for (const std::vector<double>& run_times : times) num_steps = std::max(num_steps, run_times.size());
-  std::string csv = "t,classical_anees,selective_anees,lower,upper,n_runs\n";
+  std::string csv = rundir::HeaderLine(rundir::NeesColumns());
   std::vector<int> inside(names.size(), 0);
   std::vector<int> above(names.size(), 0);
   std::vector<int> below(names.size(), 0);
@@ -302,7 +350,7 @@ nlohmann::json AggregateSweep(const std::vector<std::string>& run_dirs, const st
     csv += "," + FormatDouble(bounds.lower) + "," + FormatDouble(bounds.upper) + "," +
            std::to_string(n) + "\n";
   }
-  WriteFileAtomically(out_dir + "/nees.csv", csv);
+  rundir::WriteFileAtomically(PathIn(out_dir, rundir::kNeesFile), csv);
 
   nlohmann::json summary;
   summary["sweep"] = {{"completed_runs", static_cast<int>(run_dirs.size())},

@@ -4,7 +4,7 @@
 
 #include <nlohmann/json.hpp>
 
-namespace mjslam::app {
+namespace mjslam::rundir {
 
 /// Writes `value` to `path` through a temporary file in the same folder and a
 /// rename, so readers see either the old file or the whole new one. Throws
@@ -24,8 +24,4 @@ std::string UtcNow();
 /// cannot, or if it exists and is not a folder.
 void MakeRunDirectory(const std::string& dir);
 
-/// Version of mjslam and the git commit it was built from.
-std::string MjslamVersion();
-std::string MjslamGitCommit();
-
-}  // namespace mjslam::app
+}  // namespace mjslam::rundir

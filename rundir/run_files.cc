@@ -1,4 +1,4 @@
-#include "app/run_files.h"
+#include "rundir/run_files.h"
 
 #include <fcntl.h>
 #include <unistd.h>
@@ -12,9 +12,7 @@
 #include <fstream>
 #include <stdexcept>
 
-#include "app/git_commit.h"
-
-namespace mjslam::app {
+namespace mjslam::rundir {
 
 void WriteFileAtomically(const std::string& path, const std::string& contents) {
   const std::string temporary = path + ".tmp";
@@ -83,7 +81,4 @@ void MakeRunDirectory(const std::string& dir) {
   }
 }
 
-std::string MjslamVersion() { return MJSLAM_VERSION; }
-std::string MjslamGitCommit() { return MJSLAM_GIT_COMMIT; }
-
-}  // namespace mjslam::app
+}  // namespace mjslam::rundir
