@@ -95,6 +95,9 @@ bool IsSweepDirectory(const std::string& dir) {
 
 void RenderSweep(const std::string& sweep_dir) { RunReportScript({"sweep", sweep_dir}); }
 
+// Over 80 lines: one frame loop whose state (the frame, the next row) the
+// video and the final image share through two lambdas; to be cut into named
+// steps with the scene split (issue 11, item 2), which rewrites its start.
 RenderResult RenderRun(const std::string& run_dir, const renders::RenderParams& params,
                        const RenderOptions& options) {
   params.ValidateOrThrow();

@@ -274,144 +274,186 @@ SweepResult RunSweep(const RunConfig& config, const SweepOptions& options) {
   return result;
 }
 
-nlohmann::json AggregateSweep(const std::vector<std::string>& run_dirs, const std::string& out_dir,
-                              const SweepOptions& options) {
-  const std::vector<std::string>& names = FilterNames();
-  // Per run and filter: the NEES of every step; the times; the summaries.
-  std::vector<std::vector<std::vector<double>>> nees(names.size());
+namespace {
+
+// What the aggregate reads of each run: per filter and run the NEES of every
+// step and the time totals; per run the times and the summary.
+struct SweepRuns {
+  std::vector<std::vector<std::vector<double>>> nees;
   std::vector<std::vector<double>> times;
-  std::vector<std::vector<double>> processing_s(names.size());
-  std::vector<std::vector<double>> open_loop_s(names.size());
-  std::vector<std::vector<double>> max_period_s(names.size());
+  std::vector<std::vector<double>> processing_s;
+  std::vector<std::vector<double>> open_loop_s;
+  std::vector<std::vector<double>> max_period_s;
   std::vector<nlohmann::json> summaries;
+};
+
+SweepRuns ReadSweepRuns(const std::vector<std::string>& run_dirs) {
+  const std::vector<std::string>& names = FilterNames();
+  SweepRuns runs;
+  runs.nees.resize(names.size());
+  runs.processing_s.resize(names.size());
+  runs.open_loop_s.resize(names.size());
+  runs.max_period_s.resize(names.size());
   for (const std::string& run_dir : run_dirs) {
     const CsvTable table = rundir::ReadCsv(PathIn(run_dir, rundir::kTrajectoryFile));
     const int t = table.ColumnIndex("t");
     std::vector<double> run_times;
     for (const std::vector<double>& row : table.rows) run_times.push_back(row[t]);
-    times.push_back(run_times);
+    runs.times.push_back(run_times);
     for (std::size_t f = 0; f < names.size(); ++f) {
-      nees[f].push_back(PoseNees(table, names[f]));
+      runs.nees[f].push_back(PoseNees(table, names[f]));
       const int us = table.ColumnIndex(names[f] + "_us");
       double total_us = 0.0;
       for (const std::vector<double>& row : table.rows) total_us += row[us];
-      processing_s[f].push_back(total_us * 1e-6);
+      runs.processing_s[f].push_back(total_us * 1e-6);
       // Open loop: the run's accumulated f_open_loop at its last step.
       for (std::size_t c = 0; c < table.columns.size(); ++c) {
         if (table.columns[c] == names[f] + "_open_loop" && !table.rows.empty()) {
-          open_loop_s[f].push_back(table.rows.back()[c]);
+          runs.open_loop_s[f].push_back(table.rows.back()[c]);
         }
         if (table.columns[c] != names[f] + "_period") continue;
         double longest = 0.0;
         for (const std::vector<double>& row : table.rows) longest = std::max(longest, row[c]);
-        max_period_s[f].push_back(longest);
+        runs.max_period_s[f].push_back(longest);
       }
     }
-    summaries.push_back(ReadJsonFile(PathIn(run_dir, rundir::kSummaryFile), nlohmann::json::object()));
+    runs.summaries.push_back(ReadJsonFile(PathIn(run_dir, rundir::kSummaryFile), nlohmann::json::object()));
   }
+  return runs;
+}
 
-  // Per step: average NEES over the runs that reach it, when every such run
-  // has both filters' NEES (the known start has none).
-  std::size_t num_steps = 0;
-  for (const std::vector<double>& run_times : times) num_steps = std::max(num_steps, run_times.size());
-  std::string csv = rundir::HeaderLine(rundir::NeesColumns());
-  std::vector<int> inside(names.size(), 0);
-  std::vector<int> above(names.size(), 0);
-  std::vector<int> below(names.size(), 0);
-  std::vector<double> anees_sum(names.size(), 0.0);
+// Per filter: the steps whose average NEES lies inside, above and below the
+// bounds, and the sum of the average NEES over the steps used.
+struct NeesCounts {
+  std::vector<int> inside;
+  std::vector<int> above;
+  std::vector<int> below;
+  std::vector<double> anees_sum;
   int used_steps = 0;
+};
+
+// Per step: average NEES over the runs that reach it, when every such run
+// has both filters' NEES (the known start has none), against the bounds for
+// that many runs; written to out_dir/nees.csv.
+NeesCounts WriteAverageNees(const SweepRuns& runs, const std::string& out_dir,
+                            const SweepOptions& options) {
+  const std::size_t num_filters = FilterNames().size();
+  std::size_t num_steps = 0;
+  for (const std::vector<double>& run_times : runs.times) num_steps = std::max(num_steps, run_times.size());
+  std::string csv = rundir::HeaderLine(rundir::NeesColumns());
+  NeesCounts counts{std::vector<int>(num_filters, 0), std::vector<int>(num_filters, 0),
+                    std::vector<int>(num_filters, 0), std::vector<double>(num_filters, 0.0), 0};
   for (std::size_t k = 0; k < num_steps; ++k) {
     int n = 0;
     double t = kNaN;
     bool defined = true;
-    std::vector<double> sum(names.size(), 0.0);
-    for (std::size_t r = 0; r < run_dirs.size(); ++r) {
-      if (k >= times[r].size()) continue;
-      if (n == 0) t = times[r][k];
+    std::vector<double> sum(num_filters, 0.0);
+    for (std::size_t r = 0; r < runs.times.size(); ++r) {
+      if (k >= runs.times[r].size()) continue;
+      if (n == 0) t = runs.times[r][k];
       ++n;
-      for (std::size_t f = 0; f < names.size(); ++f) {
-        const double v = nees[f][r][k];
+      for (std::size_t f = 0; f < num_filters; ++f) {
+        const double v = runs.nees[f][r][k];
         if (!std::isfinite(v)) defined = false;
         sum[f] += v;
       }
     }
     if (n == 0 || !defined) continue;
-    ++used_steps;
+    ++counts.used_steps;
     const eval::Interval bounds = eval::AverageNeesBounds(n, 3, options.bounds_probability);
     csv += FormatDouble(t);
-    for (std::size_t f = 0; f < names.size(); ++f) {
+    for (std::size_t f = 0; f < num_filters; ++f) {
       const double anees = sum[f] / n;
-      anees_sum[f] += anees;
-      if (anees < bounds.lower) ++below[f];
-      else if (anees > bounds.upper) ++above[f];
-      else ++inside[f];
+      counts.anees_sum[f] += anees;
+      if (anees < bounds.lower) ++counts.below[f];
+      else if (anees > bounds.upper) ++counts.above[f];
+      else ++counts.inside[f];
       csv += "," + FormatDouble(anees);
     }
     csv += "," + FormatDouble(bounds.lower) + "," + FormatDouble(bounds.upper) + "," +
            std::to_string(n) + "\n";
   }
   rundir::WriteFileAtomically(PathIn(out_dir, rundir::kNeesFile), csv);
+  return counts;
+}
 
-  nlohmann::json summary;
-  summary["sweep"] = {{"completed_runs", static_cast<int>(run_dirs.size())},
-                      {"steps", used_steps},
-                      {"bounds", {{"probability", options.bounds_probability}, {"dof", 3}}},
-                      {"min_fraction_inside", options.min_fraction_inside}};
+// The aggregate of filter `f`: fractions, verdict, times, and the mean of the
+// runs' own metrics.
+nlohmann::json FilterAggregate(std::size_t f, const SweepRuns& runs, const NeesCounts& counts,
+                               const SweepOptions& options) {
+  const std::string& name = FilterNames()[f];
+  const std::size_t num_runs = runs.times.size();
+  const int used_steps = counts.used_steps;
   auto mean = [](const std::vector<double>& v) {
     if (v.empty()) return nlohmann::json(nullptr);
     double s = 0.0;
     for (const double x : v) s += x;
     return nlohmann::json(s / v.size());
   };
-  for (std::size_t f = 0; f < names.size(); ++f) {
-    nlohmann::json j;
-    const double steps = std::max(used_steps, 1);
-    j["fraction_inside"] = inside[f] / steps;
-    j["fraction_above"] = above[f] / steps;
-    j["fraction_below"] = below[f] / steps;
-    j["mean_anees"] = used_steps > 0 ? nlohmann::json(anees_sum[f] / used_steps) : nlohmann::json(nullptr);
-    std::string verdict = "consistent";
-    if (used_steps == 0) verdict = "undetermined";
-    else if (inside[f] / steps < options.min_fraction_inside) {
-      verdict = above[f] >= below[f] ? "overconfident" : "underconfident";
+  nlohmann::json j;
+  const double steps = std::max(used_steps, 1);
+  j["fraction_inside"] = counts.inside[f] / steps;
+  j["fraction_above"] = counts.above[f] / steps;
+  j["fraction_below"] = counts.below[f] / steps;
+  j["mean_anees"] = used_steps > 0 ? nlohmann::json(counts.anees_sum[f] / used_steps) : nlohmann::json(nullptr);
+  std::string verdict = "consistent";
+  if (used_steps == 0) verdict = "undetermined";
+  else if (counts.inside[f] / steps < options.min_fraction_inside) {
+    verdict = counts.above[f] >= counts.below[f] ? "overconfident" : "underconfident";
+  }
+  j["verdict"] = verdict;
+  // The processing time behind the command period (the runs' summaries:
+  // the cost model or the scaled measurement), and the measured f_us sum.
+  const nlohmann::json model = MeanOf(
+      runs.summaries, nlohmann::json::json_pointer("/filters/" + name + "/processing_s"));
+  j["processing_s"] = model;
+  j["measured_processing_s"] = mean(runs.processing_s[f]);
+  // Only when every run has the period column.
+  const std::vector<double>& max_period_s = runs.max_period_s[f];
+  j["open_loop_s"] = runs.open_loop_s[f].size() == num_runs ? mean(runs.open_loop_s[f]) : nullptr;
+  j["max_period_s"] = max_period_s.size() == num_runs && num_runs > 0
+                          ? nlohmann::json(*std::max_element(max_period_s.begin(), max_period_s.end()))
+                          : nlohmann::json(nullptr);
+  // The mean over runs of each run's own metrics (mjslam evaluate).
+  const std::string base = "/filters/" + name;
+  for (const char* key : {"mean_nees"}) {
+    j["runs_mean"][key] = MeanOf(runs.summaries, nlohmann::json::json_pointer(base + "/" + key));
+  }
+  for (const char* group : {"inside_2sigma", "rmse", "final_pose_error"}) {
+    for (const char* c : {"x", "y", "th"}) {
+      j["runs_mean"][group][c] =
+          MeanOf(runs.summaries, nlohmann::json::json_pointer(base + "/" + group + "/" + c));
     }
-    j["verdict"] = verdict;
-    // The processing time behind the command period (the runs' summaries:
-    // the cost model or the scaled measurement), and the measured f_us sum.
-    const nlohmann::json model = MeanOf(
-        summaries, nlohmann::json::json_pointer("/filters/" + names[f] + "/processing_s"));
-    j["processing_s"] = model;
-    j["measured_processing_s"] = mean(processing_s[f]);
-    // Only when every run has the period column.
-    j["open_loop_s"] = open_loop_s[f].size() == run_dirs.size() ? mean(open_loop_s[f]) : nullptr;
-    j["max_period_s"] = max_period_s[f].size() == run_dirs.size() && !run_dirs.empty()
-                            ? nlohmann::json(*std::max_element(max_period_s[f].begin(), max_period_s[f].end()))
-                            : nlohmann::json(nullptr);
-    // The mean over runs of each run's own metrics (mjslam evaluate).
-    const std::string base = "/filters/" + names[f];
-    for (const char* key : {"mean_nees"}) {
-      j["runs_mean"][key] = MeanOf(summaries, nlohmann::json::json_pointer(base + "/" + key));
-    }
-    for (const char* group : {"inside_2sigma", "rmse", "final_pose_error"}) {
-      for (const char* c : {"x", "y", "th"}) {
-        j["runs_mean"][group][c] =
-            MeanOf(summaries, nlohmann::json::json_pointer(base + "/" + group + "/" + c));
-      }
-    }
-    for (const char* key : {"num_estimates", "num_truth", "matched_estimates", "matched_truth",
-                            "matched_fraction", "duplicates", "unmatched_estimates",
-                            "inconsistent", "mean_feature_nees", "line_rho_rmse_m",
-                            "line_alpha_rmse_rad", "corner_rmse_m"}) {
-      j["runs_mean"]["map"][key] =
-          MeanOf(summaries, nlohmann::json::json_pointer(base + "/map/" + key));
-    }
-    summary["filters"][names[f]] = j;
+  }
+  for (const char* key : {"num_estimates", "num_truth", "matched_estimates", "matched_truth",
+                          "matched_fraction", "duplicates", "unmatched_estimates",
+                          "inconsistent", "mean_feature_nees", "line_rho_rmse_m",
+                          "line_alpha_rmse_rad", "corner_rmse_m"}) {
+    j["runs_mean"]["map"][key] =
+        MeanOf(runs.summaries, nlohmann::json::json_pointer(base + "/map/" + key));
+  }
+  return j;
+}
+
+}  // namespace
+
+nlohmann::json AggregateSweep(const std::vector<std::string>& run_dirs, const std::string& out_dir,
+                              const SweepOptions& options) {
+  const SweepRuns runs = ReadSweepRuns(run_dirs);
+  const NeesCounts counts = WriteAverageNees(runs, out_dir, options);
+  nlohmann::json summary;
+  summary["sweep"] = {{"completed_runs", static_cast<int>(run_dirs.size())},
+                      {"steps", counts.used_steps},
+                      {"bounds", {{"probability", options.bounds_probability}, {"dof", 3}}},
+                      {"min_fraction_inside", options.min_fraction_inside}};
+  for (std::size_t f = 0; f < FilterNames().size(); ++f) {
+    summary["filters"][FilterNames()[f]] = FilterAggregate(f, runs, counts, options);
   }
   // The mean of the runs' divergences, when they were evaluated with one.
   for (const char* pair : {"classical_selective", "selective_classical", "classical_truth",
                            "selective_truth"}) {
     const nlohmann::json value =
-        MeanOf(summaries, nlohmann::json::json_pointer(std::string("/divergence/") + pair));
+        MeanOf(runs.summaries, nlohmann::json::json_pointer(std::string("/divergence/") + pair));
     if (!value.is_null()) summary["divergence"]["runs_mean"][pair] = value;
   }
   return summary;
