@@ -5,13 +5,14 @@
 
 #include "app/scene_frame.h"
 #include "app/slam_pair.h"
+#include "rundir/layout.h"
 
 namespace mjslam::app {
 LiveVideo::LiveVideo(const RunConfig& config, const std::string& run_dir)
     : params_(config.render),
       renderer_(config.run.world, config.run.robot_model, config.sim, config.robot,
                 config.render.width, config.render.height),
-      video_(run_dir + "/video.mp4", config.render.width, config.render.height, config.render.fps,
+      video_(rundir::PathIn(run_dir, rundir::kVideoFile), config.render.width, config.render.height, config.render.fps,
              config.render.crf) {
   min_step_m_ = PixelSizeM(renderer_);
   frame_.ellipse_scale = params_.ellipse_scale;

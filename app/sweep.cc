@@ -13,9 +13,7 @@
 #include <deque>
 #include <fcntl.h>
 #include <filesystem>
-#include <fstream>
 #include <limits>
-#include <sstream>
 #include <stdexcept>
 #include <thread>
 
@@ -45,13 +43,6 @@ std::string RunName(int index) {
   char name[32];
   std::snprintf(name, sizeof(name), "run_%03d", index);
   return name;
-}
-
-std::string ReadText(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream text;
-  text << in.rdbuf();
-  return text.str();
 }
 
 // Starts `argv` with stdout and stderr appended to `log_path`.
@@ -138,7 +129,7 @@ std::string PrepareSweepDirectory(const RunConfig& config, const std::string& di
   rundir::MakeRunDirectory(PathIn(dir, rundir::kSweepRunsFolder));
   const std::string config_path = PathIn(dir, rundir::kConfigFile);
   const std::string config_text = config::ToYaml(config);
-  if (fs::exists(config_path) && ReadText(config_path) != config_text) {
+  if (fs::exists(config_path) && rundir::ReadTextFile(config_path) != config_text) {
     throw std::runtime_error(config_path +
                              ": this sweep directory was made with another config; use the same "
                              "config and --set options to resume it, or another --out");

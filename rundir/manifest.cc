@@ -29,15 +29,8 @@ nlohmann::json ReadManifest(const std::string& dir) {
 }
 
 std::optional<Pose2> ReadLaserMount(const std::string& manifest_path) {
-  std::ifstream in(manifest_path);
-  if (!in) return std::nullopt;
-  nlohmann::json manifest;
-  try {
-    manifest = nlohmann::json::parse(in);
-  } catch (const nlohmann::json::exception& error) {
-    throw std::runtime_error(manifest_path + ": not valid JSON: " + error.what());
-  }
-  if (!manifest.contains("laser_mount")) return std::nullopt;
+  const nlohmann::json manifest = ReadJsonFile(manifest_path, nullptr);
+  if (!manifest.is_object() || !manifest.contains("laser_mount")) return std::nullopt;
   const nlohmann::json& mount = manifest["laser_mount"];
   return Pose2(mount.at("x").get<double>(), mount.at("y").get<double>(),
                mount.at("th").get<double>());

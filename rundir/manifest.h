@@ -19,7 +19,8 @@ nlohmann::json ReadManifest(const std::string& dir);
 
 /// The laser mount X_RS recorded in the manifest at `manifest_path`
 /// (`laser_mount` {x, y, th}); none when the file is missing or has no mount.
-/// Throws std::runtime_error naming the file when it is not JSON.
+/// Throws std::runtime_error naming the file when it cannot be read or is not
+/// JSON.
 std::optional<Pose2> ReadLaserMount(const std::string& manifest_path);
 
 /// The manifest.json of a run directory as a command writes it: at the start

@@ -10,6 +10,7 @@
 #include <ctime>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <stdexcept>
 
 namespace mjslam::rundir {
@@ -44,6 +45,13 @@ void WriteFileAtomically(const std::string& path, const std::string& contents) {
 
 void WriteJsonAtomically(const std::string& path, const nlohmann::json& value) {
   WriteFileAtomically(path, value.dump(2) + "\n");
+}
+
+std::string ReadTextFile(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
 }
 
 std::string HashFile(const std::string& path) {

@@ -14,6 +14,9 @@ void WriteFileAtomically(const std::string& path, const std::string& contents);
 /// Pretty-printed JSON, written atomically.
 void WriteJsonAtomically(const std::string& path, const nlohmann::json& value);
 
+/// The whole text of a file; empty when it cannot be read.
+std::string ReadTextFile(const std::string& path);
+
 /// Content hash of a file: "fnv1a64:<16 hex digits>". Throws if unreadable.
 std::string HashFile(const std::string& path);
 
