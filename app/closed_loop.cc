@@ -6,6 +6,7 @@
 
 #include "app/true_coverage.h"
 #include "common/angles.h"
+#include "common/check.h"
 #include "common/rng.h"
 #include "explorer/waypoint_driver.h"
 #include "sim/laser_noise.h"
@@ -74,7 +75,8 @@ ClosedLoop::ClosedLoop(const RunConfig& config)
   }
   slam_.emplace(config_.slam, config_.control, dt_s_, X_WR0_, X_RS_);
   w.coverage.emplace(w.simulator.Obstacles(), (X_WR0_ * Pose2(-a_m, 0.0, 0.0)).translation());
-  last_step_ = static_cast<int>(std::floor(config_.run.duration_s * config_.run.control_rate_hz + 1e-9));
+  last_step_ = static_cast<int>(
+      std::floor(config_.run.duration_s * config_.run.control_rate_hz + 1e-9));
 }
 
 ClosedLoop::ClosedLoop(const RunConfig& config, const rundir::Recording& recording)
@@ -244,6 +246,7 @@ void ClosedLoop::Advance() {
 }
 
 rundir::RunSummary ClosedLoop::Summary(bool interrupted) const {
+  MJSLAM_CHECK(world_ != nullptr);
   const World& w = *world_;
   rundir::RunSummary summary;
   summary.duration_s = previous_t_s_;

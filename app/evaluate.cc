@@ -155,8 +155,10 @@ std::vector<eval::DivergenceStatistics> WriteDivergenceStudy(
     const std::string& out_path, const EvaluateOptions& options) {
   const nlohmann::json manifest = rundir::ReadManifest(run_dir);
   const eval::Map truth = RunGroundTruth(run_dir, options.ground_truth);
-  const eval::Map classical = rundir::ReadMapCsv(rundir::PathIn(run_dir, rundir::MapFile(FilterNames()[0])));
-  const eval::Map selective = rundir::ReadMapCsv(rundir::PathIn(run_dir, rundir::MapFile(FilterNames()[1])));
+  const eval::Map classical =
+      rundir::ReadMapCsv(rundir::PathIn(run_dir, rundir::MapFile(FilterNames()[0])));
+  const eval::Map selective =
+      rundir::ReadMapCsv(rundir::PathIn(run_dir, rundir::MapFile(FilterNames()[1])));
   const std::uint64_t seed = manifest.value("seed", std::uint64_t{0});
   const std::vector<eval::DivergenceStatistics> rows =
       eval::DivergenceStudy(classical, selective, truth, num_points, realisations,

@@ -12,8 +12,8 @@ LiveVideo::LiveVideo(const RunConfig& config, const std::string& run_dir)
     : params_(config.render),
       renderer_(config.run.world, config.run.robot_model, config.sim, config.robot,
                 config.render.width, config.render.height),
-      video_(rundir::PathIn(run_dir, rundir::kVideoFile), config.render.width, config.render.height, config.render.fps,
-             config.render.crf) {
+      video_(rundir::PathIn(run_dir, rundir::kVideoFile), config.render.width,
+             config.render.height, config.render.fps, config.render.crf) {
   min_step_m_ = PixelSizeM(renderer_);
   frame_.ellipse_scale = params_.ellipse_scale;
   frame_.filters = FilterLayers();

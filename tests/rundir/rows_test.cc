@@ -119,7 +119,8 @@ TEST(RecordingTest, ReadsStepsScansAndTheMountFromTheFirstScan) {
 
   // Another beam count, or a trajectory whose columns are out of order.
   EXPECT_THROW(Recording(dir + "/scans.csv", "", 3), std::runtime_error);
-  std::ofstream(dir + "/other.csv") << "t,true_y,true_x,true_th,odom_x,odom_y,odom_th,cmd_v,cmd_w\n0,1,2,0,1,2,0,0,0\n";
+  std::ofstream(dir + "/other.csv")
+      << "t,true_y,true_x,true_th,odom_x,odom_y,odom_th,cmd_v,cmd_w\n0,1,2,0,1,2,0,0,0\n";
   EXPECT_THROW(Recording(dir + "/scans.csv", dir + "/other.csv", 2), std::runtime_error);
 }
 
