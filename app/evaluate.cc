@@ -5,17 +5,22 @@
 #include <fstream>
 #include <stdexcept>
 
-#include "app/csv_writer.h"
-#include "app/map_csv.h"
 #include "app/run_config.h"
-#include "app/run_files.h"
 #include "common/rng.h"
+#include "rundir/csv_writer.h"
+#include "rundir/layout.h"
+#include "rundir/manifest.h"
+#include "rundir/map_csv.h"
+#include "rundir/run_files.h"
+#include "rundir/summary.h"
 #include "sim/obstacles.h"
 #include "sim/scene.h"
 
 namespace mjslam::app {
 namespace {
 
+using rundir::CsvTable;
+using rundir::FilterNames;
 
 nlohmann::json Xyz(const Eigen::Vector3d& v) {
   return {{"x", v(0)}, {"y", v(1)}, {"th", v(2)}};
@@ -28,19 +33,8 @@ nlohmann::json Number(double value) {
 
 }  // namespace
 
-nlohmann::json ReadJsonFile(const std::string& path, const nlohmann::json& fallback) {
-  if (!std::filesystem::exists(path)) return fallback;
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error(path + ": cannot be read");
-  try {
-    return nlohmann::json::parse(in);
-  } catch (const nlohmann::json::exception& error) {
-    throw std::runtime_error(path + ": not valid JSON: " + error.what());
-  }
-}
-
 eval::Map RunGroundTruth(const std::string& run_dir, const eval::GroundTruthParams& params) {
-  const std::string config_path = run_dir + "/config.yaml";
+  const std::string config_path = rundir::PathIn(run_dir, rundir::kConfigFile);
   if (!std::filesystem::is_regular_file(config_path)) {
     throw std::runtime_error(config_path + ": missing (is '" + run_dir + "' a run directory?)");
   }
@@ -93,22 +87,21 @@ RunEvaluation EvaluateRunDirectory(const std::string& run_dir, const EvaluateOpt
   options.ground_truth.ValidateOrThrow();
   options.match.ValidateOrThrow();
   options.divergence.ValidateOrThrow();
-  const nlohmann::json manifest = ReadJsonFile(run_dir + "/manifest.json", nullptr);
-  if (manifest.is_null()) throw std::runtime_error(run_dir + "/manifest.json: missing");
+  const nlohmann::json manifest = rundir::ReadManifest(run_dir);
   RunEvaluation result;
   result.truth = RunGroundTruth(run_dir, options.ground_truth);
-  WriteMapCsv(run_dir + "/ground_truth_map.csv", result.truth);
+  rundir::WriteMapCsv(rundir::PathIn(run_dir, rundir::kGroundTruthMapFile), result.truth);
 
   // Poses and maps of both filters.
-  const CsvTable trajectory = ReadCsv(run_dir + "/trajectory.csv");
-  if (trajectory.rows.empty()) throw std::runtime_error(run_dir + "/trajectory.csv: no rows");
+  const CsvTable trajectory = rundir::ReadCsv(rundir::PathIn(run_dir, rundir::kTrajectoryFile));
+  if (trajectory.rows.empty()) throw std::runtime_error(trajectory.path + ": no rows");
   std::vector<eval::Map> maps;
   for (const std::string& name : FilterNames()) {
     std::vector<eval::PoseStepMetrics> steps = PoseSteps(trajectory, name);
     const std::vector<double> nees = PoseNees(trajectory, name);
     for (std::size_t k = 0; k < steps.size(); ++k) steps[k].nees = nees[k];
     result.pose.push_back(eval::SummarisePoseSteps(steps));
-    maps.push_back(ReadMapCsv(run_dir + "/map_" + name + ".csv"));
+    maps.push_back(rundir::ReadMapCsv(rundir::PathIn(run_dir, rundir::MapFile(name))));
     result.map.push_back(eval::MatchMaps(maps.back(), result.truth, options.match));
   }
   if (options.divergence_points > 0) {
@@ -121,9 +114,7 @@ RunEvaluation EvaluateRunDirectory(const std::string& run_dir, const EvaluateOpt
   }
 
   // Merge into summary.json.
-  const std::string summary_path = run_dir + "/summary.json";
-  nlohmann::json summary = ReadJsonFile(summary_path, nlohmann::json::object());
-  if (!summary.is_object()) throw std::runtime_error(summary_path + ": expected a JSON object");
+  nlohmann::json summary = rundir::ReadSummary(run_dir);
   for (std::size_t i = 0; i < FilterNames().size(); ++i) {
     nlohmann::json& f = summary["filters"][FilterNames()[i]];
     const eval::PoseSummary& pose = result.pose[i];
@@ -154,28 +145,29 @@ RunEvaluation EvaluateRunDirectory(const std::string& run_dir, const EvaluateOpt
                              {"classical_truth", result.divergence.classical_truth},
                              {"selective_truth", result.divergence.selective_truth}};
   }
-  WriteJsonAtomically(summary_path, summary);
+  rundir::WriteSummary(run_dir, summary);
   return result;
 }
 
 std::vector<eval::DivergenceStatistics> WriteDivergenceStudy(
     const std::string& run_dir, const std::vector<int>& num_points, int realisations,
     const std::string& out_path, const EvaluateOptions& options) {
-  const nlohmann::json manifest = ReadJsonFile(run_dir + "/manifest.json", nullptr);
-  if (manifest.is_null()) throw std::runtime_error(run_dir + "/manifest.json: missing");
+  const nlohmann::json manifest = rundir::ReadManifest(run_dir);
   const eval::Map truth = RunGroundTruth(run_dir, options.ground_truth);
-  const eval::Map classical = ReadMapCsv(run_dir + "/map_classical.csv");
-  const eval::Map selective = ReadMapCsv(run_dir + "/map_selective.csv");
+  const eval::Map classical =
+      rundir::ReadMapCsv(rundir::PathIn(run_dir, rundir::MapFile(FilterNames()[0])));
+  const eval::Map selective =
+      rundir::ReadMapCsv(rundir::PathIn(run_dir, rundir::MapFile(FilterNames()[1])));
   const std::uint64_t seed = manifest.value("seed", std::uint64_t{0});
   const std::vector<eval::DivergenceStatistics> rows =
       eval::DivergenceStudy(classical, selective, truth, num_points, realisations,
                             Rng(seed).Fork("divergence"), options.divergence);
-  std::string text = "num_points,pair,mean,variance\n";
+  std::string text = rundir::HeaderLine(rundir::DivergenceColumns());
   for (const eval::DivergenceStatistics& row : rows) {
-    text += std::to_string(row.num_points) + "," + row.pair + "," + FormatDouble(row.mean) + "," +
-            FormatDouble(row.variance) + "\n";
+    text += std::to_string(row.num_points) + "," + row.pair + "," + rundir::FormatDouble(row.mean) +
+            "," + rundir::FormatDouble(row.variance) + "\n";
   }
-  WriteFileAtomically(out_path, text);
+  rundir::WriteFileAtomically(out_path, text);
   return rows;
 }
 

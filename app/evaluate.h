@@ -5,7 +5,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "app/csv_reader.h"
+#include "rundir/csv_reader.h"
 #include "eval/ground_truth.h"
 #include "eval/map_divergence.h"
 #include "eval/map_matching.h"
@@ -25,13 +25,8 @@ struct EvaluateOptions {
   int divergence_realisations = 1;
 };
 
-/// The names of the two filters, as in file and column names.
-inline const std::vector<std::string>& FilterNames() {
-  static const std::vector<std::string> kNames = {"classical", "selective"};
-  return kNames;
-}
-
-/// What EvaluateRunDirectory found, per filter in the order of FilterNames().
+/// What EvaluateRunDirectory found, per filter in the order of
+/// rundir::FilterNames().
 struct RunEvaluation {
   eval::Map truth;
   std::vector<eval::PoseSummary> pose;
@@ -54,7 +49,7 @@ eval::Map RunGroundTruth(const std::string& run_dir, const eval::GroundTruthPara
 /// table: its `<name>_nees` column when present, else computed from the
 /// estimate, the truth and the covariance columns (NaN where the covariance
 /// is not positive definite, e.g. the known start).
-std::vector<double> PoseNees(const CsvTable& trajectory, const std::string& name);
+std::vector<double> PoseNees(const rundir::CsvTable& trajectory, const std::string& name);
 
 /// Evaluates a finished run directory: builds the ground truth
 /// (RunGroundTruth) and writes it to ground_truth_map.csv, compares both
@@ -67,10 +62,6 @@ std::vector<double> PoseNees(const CsvTable& trajectory, const std::string& name
 /// evaluate"). Files are written atomically. Throws std::runtime_error naming
 /// the file for a missing or malformed input.
 RunEvaluation EvaluateRunDirectory(const std::string& run_dir, const EvaluateOptions& options = {});
-
-/// Reads a JSON file (std::runtime_error naming it when unreadable or not
-/// JSON); a missing file gives `fallback`.
-nlohmann::json ReadJsonFile(const std::string& path, const nlohmann::json& fallback);
 
 /// `mjslam divergence`: the paper's Figs. 6 and 7 for one run directory.
 /// For each entry of `num_points`, `realisations` realisations of the four

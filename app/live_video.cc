@@ -3,17 +3,18 @@
 #include <algorithm>
 #include <chrono>
 
-#include "app/map_csv.h"
 #include "app/scene_frame.h"
 #include "sim/scene.h"
+#include "app/slam_pair.h"
+#include "rundir/layout.h"
 
 namespace mjslam::app {
 LiveVideo::LiveVideo(const RunConfig& config, const std::string& run_dir)
     : params_(config.render),
       renderer_(sim::Scene(config.run.world, config.run.robot_model), config.sim, config.robot,
                 config.render.width, config.render.height),
-      video_(run_dir + "/video.mp4", config.render.width, config.render.height, config.render.fps,
-             config.render.crf) {
+      video_(rundir::PathIn(run_dir, rundir::kVideoFile), config.render.width,
+             config.render.height, config.render.fps, config.render.crf) {
   min_step_m_ = PixelSizeM(renderer_);
   frame_.ellipse_scale = params_.ellipse_scale;
   frame_.filters = FilterLayers();

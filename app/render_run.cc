@@ -13,12 +13,14 @@
 #include <stdexcept>
 #include <vector>
 
-#include "app/csv_reader.h"
-#include "app/map_csv.h"
 #include "app/progress.h"
 #include "app/run_config.h"
 #include "app/scene_frame.h"
 #include "renders/scene_renderer.h"
+#include "rundir/csv_reader.h"
+#include "rundir/layout.h"
+#include "rundir/map_csv.h"
+#include "rundir/rows.h"
 #include "renders/video_writer.h"
 #include "sim/scene.h"
 
@@ -35,7 +37,10 @@ struct FilterColumns {
   int x, y, th, pxx, pxy, pyy;
 };
 
-// The explorer's sets over time: rows grouped by their time.
+using rundir::CsvTable;
+using rundir::ReadCsv;
+
+// The explorer's sets over time (explorer.csv) as the layers a frame draws.
 struct ExplorerSnapshot {
   double t_s;
   renders::ExplorerLayer layer;
@@ -43,45 +48,19 @@ struct ExplorerSnapshot {
 
 std::vector<ExplorerSnapshot> ReadExplorer(const std::string& path) {
   std::vector<ExplorerSnapshot> snapshots;
-  if (!fs::exists(path)) return snapshots;
-  const CsvTable table = ReadCsv(path, {"kind"});
-  const int t = table.ColumnIndex("t");
-  table.ColumnIndex("kind");  // the only text column: text[r][0]
-  const int index = table.ColumnIndex("index"), x = table.ColumnIndex("x"), y = table.ColumnIndex("y");
-  std::vector<std::pair<double, Eigen::Vector2d>> path_points;
-  auto close = [&]() {
-    if (snapshots.empty()) return;
-    std::stable_sort(path_points.begin(), path_points.end(),
-                     [](const auto& a, const auto& b) { return a.first < b.first; });
-    for (const auto& [i, p] : path_points) snapshots.back().layer.path.push_back(p);
-    path_points.clear();
-  };
-  for (std::size_t r = 0; r < table.rows.size(); ++r) {
-    const std::vector<double>& row = table.rows[r];
-    if (snapshots.empty() || row[t] != snapshots.back().t_s) {
-      close();
-      snapshots.push_back({row[t], {}});
-    }
-    const std::string& k = table.text[r][0];
-    const Eigen::Vector2d p(row[x], row[y]);
-    if (k == "frontier") {
-      snapshots.back().layer.frontier.push_back(p);
-    } else if (k == "goal") {
-      snapshots.back().layer.goal = p;
-    } else if (k == "path") {
-      path_points.emplace_back(row[index], p);
-    } else {
-      throw std::runtime_error(path + ":" + std::to_string(r + 2) +
-                               ": kind: expected frontier, goal or path (got '" + k + "')");
-    }
+  for (const rundir::ExplorerSnapshot& read : rundir::ReadExplorerCsv(path)) {
+    renders::ExplorerLayer layer;
+    layer.frontier = read.frontier;
+    layer.goal = read.goal;
+    layer.path = read.path;
+    snapshots.push_back({read.t_s, layer});
   }
-  close();
   return snapshots;
 }
 
 // The map of a map CSV file into `layer` (none when the file is missing).
 void ReadMap(const std::string& path, renders::FilterLayer* layer) {
-  if (fs::exists(path)) SetMapLayer(ReadMapCsv(path), layer);
+  if (fs::exists(path)) SetMapLayer(rundir::ReadMapCsv(path), layer);
 }
 
 constexpr char kPython[] = "/usr/bin/python3";
@@ -111,25 +90,27 @@ void RunReportScript(const std::vector<std::string>& arguments) {
 }  // namespace
 
 bool IsSweepDirectory(const std::string& dir) {
-  return fs::is_directory(fs::path(dir) / "runs") && !fs::exists(fs::path(dir) / "trajectory.csv");
+  return fs::is_directory(fs::path(dir) / rundir::kSweepRunsFolder) &&
+         !fs::exists(fs::path(dir) / rundir::kTrajectoryFile);
 }
 
 void RenderSweep(const std::string& sweep_dir) { RunReportScript({"sweep", sweep_dir}); }
 
+// Over 80 lines: one frame loop whose state (the frame, the next row) the
+// video and the final image share through two lambdas; to be cut into named
+// steps with the scene split (issue 11, item 2), which rewrites its start.
 RenderResult RenderRun(const std::string& run_dir, const renders::RenderParams& params,
                        const RenderOptions& options) {
   params.ValidateOrThrow();
   const fs::path dir(run_dir);
   if (!fs::is_directory(dir)) throw std::runtime_error("run directory not found: '" + run_dir + "'");
-  const RunConfig config = LoadRunConfig((dir / "config.yaml").string(), {});
+  const RunConfig config = LoadRunConfig((dir / rundir::kConfigFile).string(), {});
 
   // The run's files.
-  const CsvTable trajectory = ReadCsv((dir / "trajectory.csv").string());
-  if (trajectory.rows.empty()) {
-    throw std::runtime_error((dir / "trajectory.csv").string() + ": no rows to render");
-  }
-  const CsvTable scans = ReadCsv((dir / "scans.csv").string());
-  const std::vector<ExplorerSnapshot> explorer = ReadExplorer((dir / "explorer.csv").string());
+  const CsvTable trajectory = ReadCsv((dir / rundir::kTrajectoryFile).string());
+  if (trajectory.rows.empty()) throw std::runtime_error(trajectory.path + ": no rows to render");
+  const CsvTable scans = ReadCsv((dir / rundir::kScansFile).string());
+  const std::vector<ExplorerSnapshot> explorer = ReadExplorer((dir / rundir::kExplorerFile).string());
   const int t_col = trajectory.ColumnIndex("t");
   const int true_x = trajectory.ColumnIndex("true_x"), true_y = trajectory.ColumnIndex("true_y");
   const int true_th = trajectory.ColumnIndex("true_th");
@@ -195,7 +176,7 @@ RenderResult RenderRun(const std::string& run_dir, const renders::RenderParams& 
     const auto start = std::chrono::steady_clock::now();
     const double frame_dt = params.speedup / params.fps;
     const int num_frames = static_cast<int>(std::floor(end_t / frame_dt + 1e-9)) + 1;
-    renders::VideoWriter video((dir / "video.mp4").string(), params.width, params.height, params.fps, params.crf);
+    renders::VideoWriter video((dir / rundir::kVideoFile).string(), params.width, params.height, params.fps, params.crf);
     Progress progress("render", num_frames);
     for (int k = 0; k < num_frames; ++k) {
       if (stopped()) throw std::runtime_error("render of '" + run_dir + "' interrupted; no video written");
@@ -203,7 +184,7 @@ RenderResult RenderRun(const std::string& run_dir, const renders::RenderParams& 
       advance_to(last ? end_t : k * frame_dt);
       if (last) {
         for (std::size_t i = 0; i < filters.size(); ++i) {
-          ReadMap((dir / ("map_" + frame.filters[i].name + ".csv")).string(), &frame.filters[i]);
+          ReadMap((dir / rundir::MapFile(frame.filters[i].name)).string(), &frame.filters[i]);
         }
       }
       video.AddFrame(renderer.Render(frame));
@@ -219,9 +200,9 @@ RenderResult RenderRun(const std::string& run_dir, const renders::RenderParams& 
   // The final image: the whole run with both final maps.
   advance_to(end_t);
   for (renders::FilterLayer& layer : frame.filters) {
-    ReadMap((dir / ("map_" + layer.name + ".csv")).string(), &layer);
+    ReadMap((dir / rundir::MapFile(layer.name)).string(), &layer);
   }
-  renders::WritePng((dir / "final.png").string(), renderer.Render(frame));
+  renders::WritePng((dir / rundir::kFinalImageFile).string(), renderer.Render(frame));
 
   if (params.plots) RunReportScript({"run", dir.string()});
   return result;

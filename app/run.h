@@ -1,6 +1,7 @@
 #pragma once
 
 #include <csignal>
+#include <optional>
 #include <string>
 
 #include "app/run_config.h"
@@ -36,16 +37,20 @@ struct RunResult {
   double video_fps = 0.0;
 };
 
-/// Runs one closed-loop simulation: MuJoCo steps the robot, the laser is cast
-/// at its rate, both filters run on every record, the driver steers. Writes
-/// config.yaml, manifest.json, trajectory.csv, scans.csv, map_classical.csv
-/// and map_selective.csv into `options.out_dir` (docs/run_directory.md). On an error
+/// Runs one closed-loop simulation (ClosedLoop): MuJoCo steps the robot, the
+/// laser is cast at its rate, both filters run on every record, the driver
+/// steers. Writes config.yaml, manifest.json, trajectory.csv, scans.csv,
+/// explorer.csv (explorer only), map_classical.csv, map_selective.csv and
+/// summary.json into `options.out_dir` (docs/run_directory.md). On an error
 /// the files keep every complete row so far, the manifest records the
 /// failure, and the error is rethrown.
 RunResult RunSimulation(const RunConfig& config, const RunOptions& options);
 
-/// Columns of trajectory.csv and scans.csv (the latter for `num_beams`).
-std::vector<std::string> TrajectoryColumns();
-std::vector<std::string> ScanColumns(int num_beams);
+/// The line `mjslam run` prints when the filters assume another range noise
+/// (slam.features.range_noise_std_m) than the simulated laser has
+/// (laser.range_noise_std_m); none when they agree. The two are separate on
+/// purpose (a mismatched model is an experiment), so this is a note, not an
+/// error.
+std::optional<std::string> RangeNoiseNote(const RunConfig& config);
 
 }  // namespace mjslam::app

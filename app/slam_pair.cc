@@ -4,8 +4,9 @@
 #include <cmath>
 #include <string>
 
-#include "app/map_csv.h"
 #include "eval/pose_metrics.h"
+#include "rundir/layout.h"
+#include "rundir/map_csv.h"
 #include "slam/feature_extraction.h"
 
 namespace mjslam::app {
@@ -51,50 +52,47 @@ void SlamPair::Step(const SensorRecord& record) {
   }
 }
 
-std::vector<std::string> SlamPair::Columns() {
-  std::vector<std::string> columns;
-  for (const char* prefix : {"classical", "selective"}) {
-    for (const char* name : {"x", "y", "th", "pxx", "pxy", "pxth", "pyy", "pyth", "pthth",
-                             "nfeat", "nmatched", "nupdated", "us", "period", "open_loop",
-                             "nees"}) {
-      columns.push_back(std::string(prefix) + "_" + name);
-    }
+std::vector<rundir::FilterRow> SlamPair::Rows(const Pose2& X_WR_true) const {
+  std::vector<rundir::FilterRow> rows;
+  for (const Filter& f : filters_) {
+    rundir::FilterRow row;
+    row.X_WR = f.filter.X_WR();
+    row.P = f.filter.pose_covariance();
+    row.num_features = f.report.num_features;
+    row.num_matched = f.report.num_matched;
+    row.num_updated = f.report.num_updated;
+    row.processing_us = f.processing_us;
+    row.period_s = f.period_steps * dt_s_;
+    row.open_loop_s = f.open_loop_s;
+    // Not finite where P is (nearly) singular: the known start and the steps after.
+    row.nees = eval::EvaluatePoseStep(X_WR_true, row.X_WR, row.P).nees;
+    rows.push_back(row);
   }
-  return columns;
+  return rows;
 }
 
-void SlamPair::AddColumns(const Pose2& X_WR_true, CsvWriter* writer) const {
-  for (const Filter& f : filters_) {
-    const Pose2 X_WR = f.filter.X_WR();
-    const Eigen::Matrix3d P = f.filter.pose_covariance();
-    writer->Add(X_WR.x);
-    writer->Add(X_WR.y);
-    writer->Add(X_WR.theta);
-    writer->Add(P(0, 0));
-    writer->Add(P(0, 1));
-    writer->Add(P(0, 2));
-    writer->Add(P(1, 1));
-    writer->Add(P(1, 2));
-    writer->Add(P(2, 2));
-    writer->Add(f.report.num_features);
-    writer->Add(f.report.num_matched);
-    writer->Add(f.report.num_updated);
-    writer->Add(f.processing_us);
-    writer->Add(f.period_steps * dt_s_);
-    writer->Add(f.open_loop_s);
-    // Empty where P is (nearly) singular: the known start and the steps after.
-    const double nees = eval::EvaluatePoseStep(X_WR_true, X_WR, P).nees;
-    if (std::isfinite(nees)) {
-      writer->Add(nees);
-    } else {
-      writer->AddEmpty();
-    }
+eval::Map ToEvalMap(const std::vector<slam::MapFeature>& map) {
+  eval::Map out;
+  out.reserve(map.size());
+  for (const slam::MapFeature& feature : map) {
+    eval::MapFeature f;
+    f.id = feature.id;
+    f.type = feature.type == slam::MapFeature::Type::kLine ? eval::MapFeature::Type::kLine
+                                                            : eval::MapFeature::Type::kCorner;
+    f.params = feature.params;
+    f.covariance = feature.covariance;
+    f.has_segment = feature.has_segment;
+    f.p_WA = feature.p_WA;
+    f.p_WB = feature.p_WB;
+    out.push_back(f);
   }
+  return out;
 }
 
-void SlamPair::WriteMaps(const std::string& dir) const {
-  for (const Filter& f : filters_) {
-    WriteMapCsv(dir + "/map_" + f.name + ".csv", ToEvalMap(f.filter.Map()));
+void WriteMaps(const SlamPair& slam, const std::string& dir) {
+  for (int f = 0; f < 2; ++f) {
+    rundir::WriteMapCsv(rundir::PathIn(dir, rundir::MapFile(slam.name(f))),
+                        ToEvalMap(slam.filter(f).Map()));
   }
 }
 

@@ -5,8 +5,9 @@
 #include <vector>
 
 #include "app/control.h"
-#include "app/csv_writer.h"
 #include "common/records.h"
+#include "eval/map_types.h"
+#include "rundir/rows.h"
 #include "slam/ekf_slam.h"
 #include "slam/slam_params.h"
 
@@ -27,13 +28,10 @@ class SlamPair {
   /// Runs both filters on one record.
   void Step(const SensorRecord& record);
 
-  /// The per-filter columns of trajectory.csv, for prefixes "classical" and
-  /// "selective": f_x,f_y,f_th,f_pxx,f_pxy,f_pxth,f_pyy,f_pyth,f_pthth,
-  /// f_nfeat,f_nmatched,f_nupdated,f_us,f_period,f_open_loop,f_nees.
-  static std::vector<std::string> Columns();
-  /// Appends the values of Columns() for the last step; X_WR_true is the true
-  /// pose of R for the NEES.
-  void AddColumns(const Pose2& X_WR_true, CsvWriter* writer) const;
+  /// Both filters' columns of trajectory.csv after the last step, in the
+  /// order of rundir::FilterNames(); X_WR_true is the true pose of R for
+  /// the NEES.
+  std::vector<rundir::FilterRow> Rows(const Pose2& X_WR_true) const;
 
   /// Processing time of filter `i` (0 classical, 1 selective) for the last
   /// step, seconds (ControlParams::processing), and the command period it
@@ -49,9 +47,6 @@ class SlamPair {
   /// Filter `i` by index, and its name.
   const slam::EkfSlam& filter(int i) const { return filters_[i].filter; }
   const std::string& name(int i) const { return filters_[i].name; }
-
-  /// Writes map_classical.csv and map_selective.csv into `dir`.
-  void WriteMaps(const std::string& dir) const;
 
   const slam::EkfSlam& classical() const { return filters_[0].filter; }
   const slam::EkfSlam& selective() const { return filters_[1].filter; }
@@ -75,5 +70,13 @@ class SlamPair {
   double dt_s_;
   std::vector<Filter> filters_;
 };
+
+/// A filter's map in eval's form (the same content), as the map CSV files
+/// hold it.
+eval::Map ToEvalMap(const std::vector<slam::MapFeature>& map);
+
+/// Writes each filter's map (map_classical.csv, map_selective.csv) into the
+/// run directory `dir`.
+void WriteMaps(const SlamPair& slam, const std::string& dir);
 
 }  // namespace mjslam::app

@@ -85,7 +85,10 @@ struct LaserParams {
   double max_range_m = 30.0;
   /// Scan rate, Hz. The caller casts at this rate, never on every physics step.
   double rate_hz = 10.0;
-  /// Standard deviation of the Gaussian range noise, metres.
+  /// Standard deviation of the Gaussian range noise, metres: the truth of the
+  /// simulated sensor. What the filters assume is a separate key,
+  /// `slam.features.range_noise_std_m` (same default); they differ only when
+  /// set apart on purpose, and `mjslam run` prints a note when they do.
   double range_noise_std_m = 0.005;
   /// Constant range bias added to every echo, metres.
   double range_bias_m = 0.0;

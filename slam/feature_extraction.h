@@ -14,7 +14,10 @@ namespace mjslam::slam {
 /// extraction"). Serialized under `slam.features.*` in the run config.
 struct FeatureExtractionParams {
   /// The filter's model of the beam range noise (one standard deviation),
-  /// metres. The line and corner covariances are propagated from it.
+  /// metres. The line and corner covariances are propagated from it. The
+  /// simulated sensor's own noise is a separate key,
+  /// `laser.range_noise_std_m` (same default): a model that differs from the
+  /// truth is an experiment, and `mjslam run` prints a note when they differ.
   double range_noise_std_m = 0.005;
   /// The filter's model of the beam bearing noise (one standard deviation),
   /// degrees. 0 models a perfect beam direction (the emulated SICK).

@@ -15,8 +15,8 @@ namespace {
 namespace fs = std::filesystem;
 
 // Project folders that hold code.
-const std::set<std::string> kCodeFolders = {"common", "config", "sim", "slam", "explorer",
-                                            "eval", "renders", "app"};
+const std::set<std::string> kCodeFolders = {"common", "config", "sim",     "slam", "explorer",
+                                            "eval",   "rundir", "renders", "app"};
 
 // What each folder may include from the project and from outside.
 struct Rule {
@@ -32,6 +32,9 @@ Rule RuleFor(const std::string& folder) {
   if (folder == "slam") return {{"common", "slam"}, false, false, false, false};
   if (folder == "explorer") return {{"common", "explorer"}, false, false, false, false};
   if (folder == "eval") return {{"common", "eval"}, false, false, false, false};
+  // The run directory's format: common and files. eval/map_types.h is the
+  // map feature the map CSVs hold, until one map feature lives in common/.
+  if (folder == "rundir") return {{"common", "rundir", "eval"}, false, false, false, true};
   if (folder == "config") return {{"common", "config"}, false, true, false, true};
   if (folder == "sim") return {{"common", "sim"}, true, false, false, true};
   if (folder == "renders") return {kCodeFolders, true, false, true, true};
@@ -78,6 +81,15 @@ TEST(LayeringTest, DetectsForbiddenIncludes) {
   const std::string internal = "#include \"sim/scene_model.h\"\n#include \"sim/scene.h\"\n";
   EXPECT_EQ(Violations(internal, RuleFor("app")).size(), 1u);
   EXPECT_TRUE(Violations(internal, RuleFor("renders")).empty());
+  // rundir/ may write files but knows nothing of MuJoCo, YAML, the filters
+  // or the program.
+  EXPECT_EQ(Violations(text, RuleFor("rundir")).size(), 4u);
+  EXPECT_EQ(Violations("#include \"app/run.h\"\n#include \"slam/ekf_slam.h\"\n",
+                       RuleFor("rundir")).size(),
+            2u);
+  // ... and the core folders may not write run directories.
+  EXPECT_EQ(Violations("#include <fstream>\n#include \"rundir/layout.h\"\n", RuleFor("eval")).size(),
+            2u);
 }
 
 TEST(LayeringTest, EveryFolderIncludesOnlyWhatItMay) {
@@ -99,6 +111,27 @@ TEST(LayeringTest, EveryFolderIncludesOnlyWhatItMay) {
     }
   }
   EXPECT_GT(files, 10);
+}
+
+// The closed-loop engine (app/closed_loop.*) runs the simulator or a
+// recording, the filters and the driver; it writes no files, prints nothing
+// and knows nothing of rendering or YAML (its callers do).
+TEST(LayeringTest, ClosedLoopWritesNoFilesAndDoesNotRender) {
+  const Rule rule = {{"common", "sim", "slam", "explorer", "eval", "rundir", "app"},
+                     false, false, false, false};
+  EXPECT_EQ(Violations("#include \"renders/image.h\"\n#include <fstream>\n", rule).size(), 2u);
+  const fs::path root(MJSLAM_SOURCE_DIR);
+  for (const char* file : {"app/closed_loop.h", "app/closed_loop.cc"}) {
+    std::ifstream in(root / file);
+    ASSERT_TRUE(in) << file;
+    std::stringstream text;
+    text << in.rdbuf();
+    for (const std::string& header : Violations(text.str(), rule)) {
+      ADD_FAILURE() << file << " includes " << header;
+    }
+    EXPECT_EQ(text.str().find("printf"), std::string::npos) << file;
+    EXPECT_EQ(text.str().find("CsvWriter"), std::string::npos) << file;
+  }
 }
 
 }  // namespace

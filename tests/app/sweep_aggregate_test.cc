@@ -8,14 +8,16 @@
 
 #include <gtest/gtest.h>
 
-#include "app/csv_reader.h"
 #include "app/sweep.h"
 #include "eval/chi_square.h"
+#include "rundir/csv_reader.h"
 
 namespace mjslam::app {
 namespace {
 
 namespace fs = std::filesystem;
+using rundir::CsvTable;
+using rundir::ReadCsv;
 
 std::string FreshDir(const std::string& name) {
   const fs::path dir =

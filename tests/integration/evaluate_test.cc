@@ -9,9 +9,9 @@
 #include <nlohmann/json.hpp>
 
 #include "app/evaluate.h"
-#include "app/map_csv.h"
 #include "app/run_config.h"
 #include "app/sweep.h"
+#include "rundir/map_csv.h"
 #include "tests/integration/run_helpers.h"
 
 namespace mjslam::testing {
@@ -46,7 +46,7 @@ TEST(EvaluateTest, WritesGroundTruthAndMergesMetricsIntoSummary) {
       << ReadText(dir + ".eval.log");
 
   // The room seen from inside: 4 lines (rho 3 or 4) and 4 corners.
-  const eval::Map truth = app::ReadMapCsv(dir + "/ground_truth_map.csv");
+  const eval::Map truth = rundir::ReadMapCsv(dir + "/ground_truth_map.csv");
   ASSERT_EQ(truth.size(), 8u);
   for (const eval::MapFeature& f : truth) {
     if (f.type == eval::MapFeature::Type::kLine) {
@@ -57,7 +57,7 @@ TEST(EvaluateTest, WritesGroundTruthAndMergesMetricsIntoSummary) {
       EXPECT_NEAR(std::abs(f.params.y()), 3.0, 1e-9);
     }
   }
-  const app::CsvTable table = app::ReadCsv(dir + "/ground_truth_map.csv", {"type"});
+  const rundir::CsvTable table = rundir::ReadCsv(dir + "/ground_truth_map.csv", {"type"});
   EXPECT_EQ(table.columns, (std::vector<std::string>{"id", "type", "p0", "p1", "c00", "c01", "c11",
                                                       "ax", "ay", "bx", "by"}));
 
@@ -112,7 +112,7 @@ TEST(DivergenceCommandTest, WritesMeanAndVariancePerPointsAndPair) {
                   dir + ".log"),
             0)
       << ReadText(dir + ".log");
-  const app::CsvTable table = app::ReadCsv(dir + "/divergence.csv", {"pair"});
+  const rundir::CsvTable table = rundir::ReadCsv(dir + "/divergence.csv", {"pair"});
   EXPECT_EQ(table.columns, (std::vector<std::string>{"num_points", "pair", "mean", "variance"}));
   ASSERT_EQ(table.rows.size(), 8u);
   EXPECT_EQ(table.text[0][0], "classical_selective");
@@ -160,8 +160,8 @@ TEST_F(SweepTest, RunsAreBitIdenticalToSingleRunsAndTheAggregateIsWritten) {
   for (const char* file : {"config.yaml", "scans.csv", "map_classical.csv", "map_selective.csv"}) {
     EXPECT_EQ(ReadText(run + "/" + file), ReadText(single + "/" + file)) << file;
   }
-  const app::CsvTable a = DropColumns(app::ReadCsv(run + "/trajectory.csv"), "_us");
-  const app::CsvTable b = DropColumns(app::ReadCsv(single + "/trajectory.csv"), "_us");
+  const rundir::CsvTable a = DropColumns(rundir::ReadCsv(run + "/trajectory.csv"), "_us");
+  const rundir::CsvTable b = DropColumns(rundir::ReadCsv(single + "/trajectory.csv"), "_us");
   EXPECT_EQ(a.columns, b.columns);
   // Bit for bit; empty cells (NaN, e.g. f_nees at the known start) must be
   // empty in both.
@@ -178,7 +178,7 @@ TEST_F(SweepTest, RunsAreBitIdenticalToSingleRunsAndTheAggregateIsWritten) {
 
   // nees.csv: a row per step with a defined NEES in every run (not the known
   // start, nor a step still at zero covariance), 3 runs each.
-  const app::CsvTable nees = app::ReadCsv(dir + "/nees.csv");
+  const rundir::CsvTable nees = rundir::ReadCsv(dir + "/nees.csv");
   EXPECT_EQ(nees.columns, (std::vector<std::string>{"t", "classical_anees", "selective_anees",
                                                      "lower", "upper", "n_runs"}));
   EXPECT_GE(nees.rows.size(), 55u);

@@ -61,7 +61,7 @@ TEST_P(GroundTruthWorldTest, EveryEchoLiesOnATrueSegmentOrAPillar) {
 
   // Echoes: the scan's ranges from the true laser pose. 5 mm range noise,
   // so within 3 cm of a true segment (or a pillar) for every echo.
-  const app::CsvTable scans = app::ReadCsv(dir + "/scans.csv");
+  const rundir::CsvTable scans = rundir::ReadCsv(dir + "/scans.csv");
   const double max_range = config.laser.max_range_m;
   int echoes = 0;
   int off = 0;

@@ -9,7 +9,7 @@
 
 #include <gtest/gtest.h>
 
-#include "app/csv_reader.h"
+#include "rundir/csv_reader.h"
 #include "renders/image.h"
 #include "tests/integration/run_helpers.h"
 
@@ -78,7 +78,7 @@ TEST(RenderTest, RunAndRenderLeaveImageVideoPlotsAndAPageThatLoads) {
     fs::remove(older + "/" + name);
   }
   {
-    const app::CsvTable table = app::ReadCsv(dir + "/trajectory.csv");
+    const rundir::CsvTable table = rundir::ReadCsv(dir + "/trajectory.csv");
     std::vector<std::size_t> kept;
     for (std::size_t c = 0; c < table.columns.size(); ++c) {
       const std::string& name = table.columns[c];

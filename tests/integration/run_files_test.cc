@@ -9,13 +9,14 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "rundir/layout.h"
 #include "tests/integration/run_helpers.h"
 
 namespace mjslam::testing {
 namespace {
 
-using app::CsvTable;
-using app::ReadCsv;
+using rundir::CsvTable;
+using rundir::ReadCsv;
 
 // A short run of the default config into `dir`.
 int ShortRun(const std::string& dir, int seed, const std::string& extra = "") {
@@ -56,23 +57,19 @@ std::string* RunFilesTest::first_ = nullptr;
 std::string* RunFilesTest::second_ = nullptr;
 
 TEST_F(RunFilesTest, WritesEveryFileWithTheDocumentedColumns) {
+  // Exactly the columns of rundir/layout.h (which tests/rundir/layout_test.cc
+  // checks against docs/run_directory.md).
   const CsvTable trajectory = ReadCsv(*first_ + "/trajectory.csv");
-  const std::vector<std::string> head = {"t",      "true_x",  "true_y", "true_th", "odom_x",
-                                         "odom_y", "odom_th", "cmd_v",  "cmd_w"};
-  ASSERT_GE(trajectory.columns.size(), head.size());
-  EXPECT_TRUE(std::equal(head.begin(), head.end(), trajectory.columns.begin()));
-  for (const std::string f : {"classical", "selective"}) {
-    for (const std::string c : {"x", "y", "th", "pxx", "pxy", "pxth", "pyy", "pyth", "pthth",
-                                "nfeat", "nmatched", "nupdated", "us"}) {
-      EXPECT_NO_THROW(trajectory.ColumnIndex(f + "_" + c)) << f + "_" + c;
-    }
-  }
+  EXPECT_EQ(trajectory.columns, rundir::TrajectoryColumns());
+  EXPECT_EQ(trajectory.columns[9], "explored");
+  EXPECT_EQ(trajectory.columns.back(), "selective_nees");
+  EXPECT_EQ(ReadCsv(*first_ + "/explorer.csv", {"kind"}).columns, rundir::ExplorerColumns());
   // 12 s at 10 Hz: steps at t = 0, 0.1, ..., 12.
   ASSERT_EQ(trajectory.rows.size(), 121u);
   EXPECT_NEAR(trajectory.rows.back()[0], 12.0, 1e-9);
 
   const CsvTable scans = ReadCsv(*first_ + "/scans.csv");
-  ASSERT_EQ(scans.columns.size(), 4u + 181u);
+  ASSERT_EQ(scans.columns, rundir::ScanColumns(181));
   EXPECT_EQ(scans.columns[4], "r0");
   EXPECT_EQ(scans.columns.back(), "r180");
   EXPECT_EQ(scans.rows.size(), 121u);
@@ -86,6 +83,7 @@ TEST_F(RunFilesTest, WritesEveryFileWithTheDocumentedColumns) {
   for (const std::string map : {"map_classical.csv", "map_selective.csv"}) {
     const std::string text = ReadText(*first_ + "/" + map);
     EXPECT_EQ(text.substr(0, text.find('\n')), "id,type,p0,p1,c00,c01,c11,ax,ay,bx,by");
+    EXPECT_EQ(text.substr(0, text.find('\n') + 1), rundir::HeaderLine(rundir::MapColumns()));
   }
   const nlohmann::json manifest = nlohmann::json::parse(ReadText(*first_ + "/manifest.json"));
   EXPECT_EQ(manifest["status"], "completed");

@@ -11,7 +11,7 @@
 #include <string>
 #include <vector>
 
-#include "app/csv_reader.h"
+#include "rundir/csv_reader.h"
 
 namespace mjslam::testing {
 
@@ -47,8 +47,8 @@ inline std::string ReadText(const std::string& path) {
 
 /// A table without the columns whose name ends with `suffix` (e.g. "_us",
 /// the measured processing times, which differ from run to run).
-inline app::CsvTable DropColumns(const app::CsvTable& table, const std::string& suffix) {
-  app::CsvTable out;
+inline rundir::CsvTable DropColumns(const rundir::CsvTable& table, const std::string& suffix) {
+  rundir::CsvTable out;
   out.path = table.path;
   std::vector<int> keep;
   for (int i = 0; i < static_cast<int>(table.columns.size()); ++i) {

@@ -27,8 +27,8 @@ class SlamRunTest : public ::testing::Test {
                 0)
           << ReadText(dir + ".log");
       if (dir_ == nullptr) dir_ = new std::string(dir);  // maps of the first run
-      const app::CsvTable run = app::ReadCsv(dir + "/trajectory.csv");
-      if (table_ == nullptr) table_ = new app::CsvTable(run);
+      const rundir::CsvTable run = rundir::ReadCsv(dir + "/trajectory.csv");
+      if (table_ == nullptr) table_ = new rundir::CsvTable(run);
       else table_->rows.insert(table_->rows.end(), run.rows.begin(), run.rows.end());
     }
   }
@@ -42,10 +42,10 @@ class SlamRunTest : public ::testing::Test {
     return table_->rows[row][table_->ColumnIndex(column)];
   }
   static std::string* dir_;
-  static app::CsvTable* table_;
+  static rundir::CsvTable* table_;
 };
 std::string* SlamRunTest::dir_ = nullptr;
-app::CsvTable* SlamRunTest::table_ = nullptr;
+rundir::CsvTable* SlamRunTest::table_ = nullptr;
 
 TEST_F(SlamRunTest, PoseErrorsStayNearTwoSigma) {
   // Issue target: both filters keep each component inside 2 sigma for
@@ -115,7 +115,7 @@ TEST_F(SlamRunTest, SelectiveUsesAtMostMaxObservationsClassicalUsesAll) {
 
 TEST_F(SlamRunTest, MapCovariancesArePositiveDefinite) {
   for (const std::string f : {"classical", "selective"}) {
-    const app::CsvTable map = app::ReadCsv(*dir_ + "/map_" + f + ".csv", {"type"});
+    const rundir::CsvTable map = rundir::ReadCsv(*dir_ + "/map_" + f + ".csv", {"type"});
     ASSERT_GT(map.rows.size(), 10u);
     for (const std::vector<double>& row : map.rows) {
       const double c00 = row[map.ColumnIndex("c00")];

@@ -1,32 +1,32 @@
-// The map CSV files: a filter's map written and read back unchanged.
+// The map CSV files: a map written and read back unchanged.
 #include <filesystem>
 #include <fstream>
 
 #include <gtest/gtest.h>
 
-#include "app/map_csv.h"
+#include "rundir/map_csv.h"
 
-namespace mjslam::app {
+namespace mjslam::rundir {
 namespace {
 
-TEST(MapCsvTest, FilterMapRoundTripsBitForBit) {
-  slam::MapFeature line;
+TEST(MapCsvTest, MapRoundTripsBitForBit) {
+  eval::MapFeature line;
   line.id = 3;
-  line.type = slam::MapFeature::Type::kLine;
+  line.type = eval::MapFeature::Type::kLine;
   line.params = {2.0 / 3.0, -0.1};
   line.covariance << 1e-6, 2e-7, 2e-7, 3e-8;
   line.has_segment = true;
   line.p_WA = {0.1, 1.0 / 7.0};
   line.p_WB = {-4.0, 0.7};
-  slam::MapFeature corner;
+  eval::MapFeature corner;
   corner.id = 8;
-  corner.type = slam::MapFeature::Type::kCorner;
+  corner.type = eval::MapFeature::Type::kCorner;
   corner.params = {1.25, -3.5};
   corner.covariance << 4e-4, -1e-5, -1e-5, 9e-4;
 
   const std::string path =
       (std::filesystem::temp_directory_path() / "mjslam_map_csv_test.csv").string();
-  WriteMapCsv(path, ToEvalMap({line, corner}));
+  WriteMapCsv(path, {line, corner});
   const eval::Map map = ReadMapCsv(path);
   ASSERT_EQ(map.size(), 2u);
   EXPECT_EQ(map[0].id, 3);
@@ -59,4 +59,4 @@ TEST(MapCsvTest, UnknownTypeIsAnErrorNamingFileAndLine) {
 }
 
 }  // namespace
-}  // namespace mjslam::app
+}  // namespace mjslam::rundir

@@ -1,4 +1,4 @@
-#include "app/run_files.h"
+#include "rundir/run_files.h"
 
 #include <fcntl.h>
 #include <unistd.h>
@@ -10,11 +10,10 @@
 #include <ctime>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <stdexcept>
 
-#include "app/git_commit.h"
-
-namespace mjslam::app {
+namespace mjslam::rundir {
 
 void WriteFileAtomically(const std::string& path, const std::string& contents) {
   const std::string temporary = path + ".tmp";
@@ -46,6 +45,13 @@ void WriteFileAtomically(const std::string& path, const std::string& contents) {
 
 void WriteJsonAtomically(const std::string& path, const nlohmann::json& value) {
   WriteFileAtomically(path, value.dump(2) + "\n");
+}
+
+std::string ReadTextFile(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  return text.str();
 }
 
 std::string HashFile(const std::string& path) {
@@ -83,7 +89,4 @@ void MakeRunDirectory(const std::string& dir) {
   }
 }
 
-std::string MjslamVersion() { return MJSLAM_VERSION; }
-std::string MjslamGitCommit() { return MJSLAM_GIT_COMMIT; }
-
-}  // namespace mjslam::app
+}  // namespace mjslam::rundir

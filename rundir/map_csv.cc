@@ -1,31 +1,14 @@
-#include "app/map_csv.h"
+#include "rundir/map_csv.h"
 
 #include <cmath>
 #include <stdexcept>
 
-#include "app/csv_reader.h"
-#include "app/csv_writer.h"
-#include "app/run_files.h"
+#include "rundir/csv_reader.h"
+#include "rundir/csv_writer.h"
+#include "rundir/layout.h"
+#include "rundir/run_files.h"
 
-namespace mjslam::app {
-
-eval::Map ToEvalMap(const std::vector<slam::MapFeature>& map) {
-  eval::Map out;
-  out.reserve(map.size());
-  for (const slam::MapFeature& feature : map) {
-    eval::MapFeature f;
-    f.id = feature.id;
-    f.type = feature.type == slam::MapFeature::Type::kLine ? eval::MapFeature::Type::kLine
-                                                            : eval::MapFeature::Type::kCorner;
-    f.params = feature.params;
-    f.covariance = feature.covariance;
-    f.has_segment = feature.has_segment;
-    f.p_WA = feature.p_WA;
-    f.p_WB = feature.p_WB;
-    out.push_back(f);
-  }
-  return out;
-}
+namespace mjslam::rundir {
 
 eval::Map ReadMapCsv(const std::string& path) {
   const CsvTable table = ReadCsv(path, {"type"});
@@ -66,7 +49,7 @@ eval::Map ReadMapCsv(const std::string& path) {
 }
 
 void WriteMapCsv(const std::string& path, const eval::Map& map) {
-  std::string text = "id,type,p0,p1,c00,c01,c11,ax,ay,bx,by\n";
+  std::string text = HeaderLine(MapColumns());
   for (const eval::MapFeature& f : map) {
     const bool line = f.type == eval::MapFeature::Type::kLine;
     text += std::to_string(f.id) + (line ? ",line," : ",corner,");
@@ -85,4 +68,4 @@ void WriteMapCsv(const std::string& path, const eval::Map& map) {
   WriteFileAtomically(path, text);
 }
 
-}  // namespace mjslam::app
+}  // namespace mjslam::rundir

@@ -4,7 +4,7 @@
 
 #include <nlohmann/json.hpp>
 
-namespace mjslam::app {
+namespace mjslam::rundir {
 
 /// Writes `value` to `path` through a temporary file in the same folder and a
 /// rename, so readers see either the old file or the whole new one. Throws
@@ -13,6 +13,9 @@ void WriteFileAtomically(const std::string& path, const std::string& contents);
 
 /// Pretty-printed JSON, written atomically.
 void WriteJsonAtomically(const std::string& path, const nlohmann::json& value);
+
+/// The whole text of a file; empty when it cannot be read.
+std::string ReadTextFile(const std::string& path);
 
 /// Content hash of a file: "fnv1a64:<16 hex digits>". Throws if unreadable.
 std::string HashFile(const std::string& path);
@@ -24,8 +27,4 @@ std::string UtcNow();
 /// cannot, or if it exists and is not a folder.
 void MakeRunDirectory(const std::string& dir);
 
-/// Version of mjslam and the git commit it was built from.
-std::string MjslamVersion();
-std::string MjslamGitCommit();
-
-}  // namespace mjslam::app
+}  // namespace mjslam::rundir

@@ -4,7 +4,7 @@
 #include <string_view>
 #include <vector>
 
-namespace mjslam::app {
+namespace mjslam::rundir {
 
 /// Writes a CSV file so that an interrupted or failed run never leaves a
 /// corrupt one: rows are buffered whole and handed to the kernel with one
@@ -46,4 +46,4 @@ class CsvWriter {
 /// Shortest round-trip text of a double ("nan" and "inf" spelled so).
 std::string FormatDouble(double value);
 
-}  // namespace mjslam::app
+}  // namespace mjslam::rundir

@@ -3,7 +3,7 @@
 #include <string>
 #include <vector>
 
-namespace mjslam::app {
+namespace mjslam::rundir {
 
 /// A numeric CSV file with a header row, read whole.
 struct CsvTable {
@@ -24,4 +24,4 @@ struct CsvTable {
 /// or a row with the wrong number of fields.
 CsvTable ReadCsv(const std::string& path, const std::vector<std::string>& text_columns = {});
 
-}  // namespace mjslam::app
+}  // namespace mjslam::rundir

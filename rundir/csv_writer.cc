@@ -1,4 +1,4 @@
-#include "app/csv_writer.h"
+#include "rundir/csv_writer.h"
 
 #include <fcntl.h>
 #include <unistd.h>
@@ -11,7 +11,7 @@
 
 #include "common/check.h"
 
-namespace mjslam::app {
+namespace mjslam::rundir {
 namespace {
 
 // Flush when this many bytes of complete rows are waiting.
@@ -91,4 +91,4 @@ void CsvWriter::Flush() {
   buffer_.clear();
 }
 
-}  // namespace mjslam::app
+}  // namespace mjslam::rundir

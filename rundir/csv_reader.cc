@@ -1,4 +1,4 @@
-#include "app/csv_reader.h"
+#include "rundir/csv_reader.h"
 
 #include <cmath>
 #include <cstdlib>
@@ -7,7 +7,7 @@
 #include <sstream>
 #include <stdexcept>
 
-namespace mjslam::app {
+namespace mjslam::rundir {
 namespace {
 
 std::vector<std::string> SplitFields(const std::string& line) {
@@ -78,4 +78,4 @@ CsvTable ReadCsv(const std::string& path, const std::vector<std::string>& text_c
   return table;
 }
 
-}  // namespace mjslam::app
+}  // namespace mjslam::rundir

@@ -5,10 +5,10 @@
 
 #include <gtest/gtest.h>
 
-#include "app/csv_reader.h"
-#include "app/csv_writer.h"
+#include "rundir/csv_reader.h"
+#include "rundir/csv_writer.h"
 
-namespace mjslam::app {
+namespace mjslam::rundir {
 namespace {
 
 std::string TempPath(const std::string& name) {
@@ -106,4 +106,4 @@ TEST(CsvTest, UnwritableFileIsAnErrorNamingIt) {
 }
 
 }  // namespace
-}  // namespace mjslam::app
+}  // namespace mjslam::rundir

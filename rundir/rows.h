@@ -1,0 +1,80 @@
+#pragma once
+
+// The rows of a run directory's CSV files as plain data, and their writers
+// and readers (columns: rundir/layout.h).
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "common/pose2.h"
+#include "common/records.h"
+#include "rundir/csv_writer.h"
+
+namespace mjslam::rundir {
+
+/// One filter's columns of a trajectory.csv row (FilterColumnSuffixes()).
+struct FilterRow {
+  /// The estimate of R in W after the step, and its 3x3 pose covariance
+  /// (x, y, th; metres, radians).
+  Pose2 X_WR;
+  Eigen::Matrix3d P = Eigen::Matrix3d::Zero();
+  /// Map size, observations matched, observations used in the correction.
+  int num_features = 0;
+  int num_matched = 0;
+  int num_updated = 0;
+  /// Measured processing time of the step, microseconds.
+  double processing_us = 0.0;
+  /// The command period the step's processing imposes, and the open-loop
+  /// time so far on the filter's own command timeline, seconds.
+  double period_s = 0.0;
+  double open_loop_s = 0.0;
+  /// Pose NEES of the step (3 dof); not finite: written as an empty field.
+  double nees = 0.0;
+};
+
+/// One row of trajectory.csv (TrajectoryColumns()).
+struct TrajectoryRow {
+  /// Time of the step, seconds.
+  double t_s = 0.0;
+  /// True pose and wheel-odometry pose of R in W.
+  Pose2 X_WR_true;
+  Pose2 X_WR_odometry;
+  /// The command applied from t_s to the next step.
+  Twist2 command;
+  /// Explored fraction in [0, 1]; not finite: written as an empty field
+  /// (a replay of a recording that has none).
+  double explored = 0.0;
+  /// One per filter, in the order of FilterNames().
+  std::vector<FilterRow> filters;
+};
+
+/// Appends `row` to a trajectory.csv writer (numbers shortest round-trip).
+void AddTrajectoryRow(const TrajectoryRow& row, CsvWriter* trajectory);
+
+/// Appends a row of scans.csv: time, the true laser pose X_WS and the
+/// ranges, metres.
+void AddScanRow(double t_s, const Pose2& X_WS, const std::vector<double>& ranges_m,
+                CsvWriter* scans);
+
+/// The explorer's sets at one time, as explorer.csv stores them (points in W,
+/// metres): candidate frontier points, the goal, the planned path in order.
+struct ExplorerSnapshot {
+  double t_s = 0.0;
+  std::vector<Eigen::Vector2d> frontier;
+  std::optional<Eigen::Vector2d> goal;
+  std::vector<Eigen::Vector2d> path;
+};
+
+/// Appends the rows of `snapshot` to an explorer.csv writer: kind
+/// "frontier", "goal" and "path", each with its index.
+void AddExplorerRows(const ExplorerSnapshot& snapshot, CsvWriter* explorer);
+
+/// Reads explorer.csv into its snapshots, in the order of time (rows of one
+/// time form one snapshot; path points sorted by index). A missing file
+/// gives none. Throws std::runtime_error naming the file and line of an
+/// unknown kind.
+std::vector<ExplorerSnapshot> ReadExplorerCsv(const std::string& path);
+
+}  // namespace mjslam::rundir

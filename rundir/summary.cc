@@ -1,0 +1,48 @@
+#include "rundir/summary.h"
+
+#include <stdexcept>
+
+#include "rundir/layout.h"
+#include "rundir/manifest.h"
+#include "rundir/run_files.h"
+
+namespace mjslam::rundir {
+
+nlohmann::json ToJson(const RunSummary& summary) {
+  auto time_or_null = [](const std::optional<double>& t) {
+    return t ? nlohmann::json(*t) : nlohmann::json(nullptr);
+  };
+  nlohmann::json json;
+  json["run"] = {{"duration_s", summary.duration_s},
+                 {"distance_m", summary.distance_m},
+                 {"collisions", summary.collisions},
+                 {"contact_steps", summary.contact_steps},
+                 {"termination_reason", summary.termination_reason},
+                 {"driver", summary.driver},
+                 {"pose_source", summary.pose_source},
+                 {"explored_fraction", summary.explored_fraction},
+                 {"reachable_area_m2", summary.reachable_area_m2},
+                 {"t_explored_90_s", time_or_null(summary.t_explored_90_s)},
+                 {"t_explored_99_s", time_or_null(summary.t_explored_99_s)}};
+  for (const RunSummary::Filter& f : summary.filters) {
+    json["filters"][f.name] = {
+        {"final_pose_error", {{"x", f.error_x}, {"y", f.error_y}, {"th", f.error_th}}},
+        {"num_features", f.num_features},
+        {"processing_s", f.processing_s},
+        {"open_loop_s", f.open_loop_s}};
+  }
+  return json;
+}
+
+nlohmann::json ReadSummary(const std::string& dir) {
+  const std::string path = PathIn(dir, kSummaryFile);
+  nlohmann::json summary = ReadJsonFile(path, nlohmann::json::object());
+  if (!summary.is_object()) throw std::runtime_error(path + ": expected a JSON object");
+  return summary;
+}
+
+void WriteSummary(const std::string& dir, const nlohmann::json& summary) {
+  WriteJsonAtomically(PathIn(dir, kSummaryFile), summary);
+}
+
+}  // namespace mjslam::rundir
