@@ -4,16 +4,12 @@
 #include <vector>
 
 #include "eval/map_types.h"
-#include "slam/ekf_slam.h"
 
 namespace mjslam::app {
 
 /// The map CSV files of a run directory (map_classical.csv,
 /// map_selective.csv, ground_truth_map.csv): one row per feature,
 /// id,type,p0,p1,c00,c01,c11,ax,ay,bx,by (README, "The run directory").
-
-/// A filter's map in eval's form (the same content).
-eval::Map ToEvalMap(const std::vector<slam::MapFeature>& map);
 
 /// Reads a map CSV. Throws std::runtime_error naming the file, line and
 /// value for an unknown type or a missing field.

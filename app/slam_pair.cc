@@ -94,7 +94,7 @@ void SlamPair::AddColumns(const Pose2& X_WR_true, CsvWriter* writer) const {
 
 void SlamPair::WriteMaps(const std::string& dir) const {
   for (const Filter& f : filters_) {
-    WriteMapCsv(dir + "/map_" + f.name + ".csv", ToEvalMap(f.filter.Map()));
+    WriteMapCsv(dir + "/map_" + f.name + ".csv", f.filter.Map());
   }
 }
 
