@@ -29,8 +29,9 @@ TEST(SegmentsTest, RaySegmentCastHitsInFrontOnlyWithinTheSegment) {
   EXPECT_DOUBLE_EQ(RaySegmentCast({0.0, 0.0}, {1.0, 0.0}, a, b), 3.0);
   EXPECT_DOUBLE_EQ(RaySegmentCast({1.0, 2.0}, {1.0, 0.0}, a, b), 2.0);  // end point
   const double diagonal = std::sqrt(0.5);
-  EXPECT_NEAR(RaySegmentCast({0.0, 0.0}, {diagonal, diagonal}, a, b), 3.0 * std::sqrt(2.0),
+  EXPECT_NEAR(RaySegmentCast({1.0, -1.0}, {diagonal, diagonal}, a, b), 2.0 * std::sqrt(2.0),
               1e-12);
+  EXPECT_TRUE(std::isinf(RaySegmentCast({0.0, 0.0}, {diagonal, diagonal}, a, b)));  // above b
   EXPECT_TRUE(std::isinf(RaySegmentCast({0.0, 0.0}, {-1.0, 0.0}, a, b)));  // behind
   EXPECT_TRUE(std::isinf(RaySegmentCast({0.0, 2.5}, {1.0, 0.0}, a, b)));   // past b
   EXPECT_TRUE(std::isinf(RaySegmentCast({0.0, 0.0}, {0.0, 1.0}, a, b)));   // parallel
