@@ -14,6 +14,7 @@
 #include <gtest/gtest.h>
 
 #include "explorer/explorer.h"
+#include "tests/support/kinematic_sim.h"
 #include "tests/support/seen_area.h"
 #include "tests/support/world_walls.h"
 

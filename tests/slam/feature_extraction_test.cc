@@ -84,16 +84,7 @@ std::vector<Wall> Polygon(const std::vector<Eigen::Vector2d>& corners) {
 // The true polar line (rho, alpha) of a wall, in the sensor frame S.
 Eigen::Vector2d TrueLineInSensor(const Wall& wall, const Pose2& X_WS) {
   const Pose2 X_SW = X_WS.Inverse();
-  const Eigen::Vector2d a = X_SW * wall.a;
-  const Eigen::Vector2d b = X_SW * wall.b;
-  const Eigen::Vector2d direction = (b - a).normalized();
-  Eigen::Vector2d normal(-direction.y(), direction.x());
-  double rho = normal.dot(a);
-  if (rho < 0.0) {
-    rho = -rho;
-    normal = -normal;
-  }
-  return {rho, std::atan2(normal.y(), normal.x())};
+  return testing::PolarLineThrough(X_SW * wall.a, X_SW * wall.b);
 }
 
 // Normalised innovation squared of an estimate of (a, angle) against the truth.

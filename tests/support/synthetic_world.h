@@ -74,16 +74,10 @@ inline slam::ScanFeatures ObserveWorld(const SyntheticWorld& world, const Pose2&
     if (p_SB.x() < kFront) p_SB = p_SA + (p_SB - p_SA) * (p_SA.x() - kFront) / (p_SA.x() - p_SB.x());
     if (std::min(p_SA.norm(), p_SB.norm()) > noise.max_range_m) continue;
     // The line through the two points, in polar form with rho >= 0.
-    const Eigen::Vector2d direction = (p_SB - p_SA).normalized();
-    Eigen::Vector2d normal(-direction.y(), direction.x());
-    double rho = normal.dot(p_SA);
-    if (rho < 0.0) {
-      normal = -normal;
-      rho = -rho;
-    }
+    const Eigen::Vector2d polar = PolarLineThrough(p_SA, p_SB);
     slam::LineObservation line;
-    line.rho_m = rho + draw(noise.rho_std_m);
-    line.alpha_rad = WrapAngle(std::atan2(normal.y(), normal.x()) + draw(noise.alpha_std_rad));
+    line.rho_m = polar[0] + draw(noise.rho_std_m);
+    line.alpha_rad = WrapAngle(polar[1] + draw(noise.alpha_std_rad));
     if (line.rho_m < 0.0) {
       line.rho_m = -line.rho_m;
       line.alpha_rad = WrapAngle(line.alpha_rad + kPi);

@@ -72,6 +72,20 @@ inline bool SegmentMeetsRectangle(const Eigen::Vector2d& p, const Eigen::Vector2
   return true;
 }
 
+/// The polar form (rho, alpha) of the line through `a` and `b` (a != b), in
+/// their frame: x cos(alpha) + y sin(alpha) = rho with rho >= 0 and alpha
+/// the angle of the line's normal, in (-pi, pi].
+inline Eigen::Vector2d PolarLineThrough(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  const Eigen::Vector2d direction = (b - a).normalized();
+  Eigen::Vector2d normal(-direction.y(), direction.x());
+  double rho = normal.dot(a);
+  if (rho < 0.0) {
+    rho = -rho;
+    normal = -normal;
+  }
+  return {rho, std::atan2(normal.y(), normal.x())};
+}
+
 /// Walls of an axis-aligned rectangle [x0, x1] x [y0, y1].
 inline std::vector<Wall> Box(double x0, double y0, double x1, double y1) {
   return {{{x0, y0}, {x1, y0}}, {{x1, y0}, {x1, y1}}, {{x1, y1}, {x0, y1}}, {{x0, y1}, {x0, y0}}};
