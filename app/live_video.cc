@@ -41,7 +41,7 @@ void LiveVideo::Step(double t_s, const Pose2& X_WR_true, const SlamPair& slam,
 
   // A frame is due: the maps and the explorer as they are now.
   const auto start = std::chrono::steady_clock::now();
-  for (int i = 0; i < 2; ++i) SetMapLayer(ToEvalMap(slam.filter(i).Map()), &frame_.filters[i]);
+  for (int i = 0; i < 2; ++i) SetMapLayer(slam.filter(i).Map(), &frame_.filters[i]);
   frame_.explorer.reset();
   if (explorer != nullptr) {
     renders::ExplorerLayer layer;

@@ -28,8 +28,8 @@ void AppendPathPoint(std::vector<Eigen::Vector2d>* path, const Eigen::Vector2d& 
 void SetMapLayer(const eval::Map& map, renders::FilterLayer* layer) {
   layer->lines.clear();
   layer->corners.clear();
-  for (const eval::MapFeature& feature : map) {
-    if (feature.type == eval::MapFeature::Type::kCorner) {
+  for (const MapFeature& feature : map) {
+    if (feature.type == MapFeature::Type::kCorner) {
       layer->corners.push_back(feature.params);
     } else if (feature.has_segment) {
       layer->lines.push_back({feature.p_WA, feature.p_WB});

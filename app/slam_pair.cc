@@ -71,28 +71,10 @@ std::vector<rundir::FilterRow> SlamPair::Rows(const Pose2& X_WR_true) const {
   return rows;
 }
 
-eval::Map ToEvalMap(const std::vector<slam::MapFeature>& map) {
-  eval::Map out;
-  out.reserve(map.size());
-  for (const slam::MapFeature& feature : map) {
-    eval::MapFeature f;
-    f.id = feature.id;
-    f.type = feature.type == slam::MapFeature::Type::kLine ? eval::MapFeature::Type::kLine
-                                                            : eval::MapFeature::Type::kCorner;
-    f.params = feature.params;
-    f.covariance = feature.covariance;
-    f.has_segment = feature.has_segment;
-    f.p_WA = feature.p_WA;
-    f.p_WB = feature.p_WB;
-    out.push_back(f);
-  }
-  return out;
-}
-
 void WriteMaps(const SlamPair& slam, const std::string& dir) {
   for (int f = 0; f < 2; ++f) {
     rundir::WriteMapCsv(rundir::PathIn(dir, rundir::MapFile(slam.name(f))),
-                        ToEvalMap(slam.filter(f).Map()));
+                        slam.filter(f).Map());
   }
 }
 

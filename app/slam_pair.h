@@ -71,10 +71,6 @@ class SlamPair {
   std::vector<Filter> filters_;
 };
 
-/// A filter's map in eval's form (the same content), as the map CSV files
-/// hold it.
-eval::Map ToEvalMap(const std::vector<slam::MapFeature>& map);
-
 /// Writes each filter's map (map_classical.csv, map_selective.csv) into the
 /// run directory `dir`.
 void WriteMaps(const SlamPair& slam, const std::string& dir);

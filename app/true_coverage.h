@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 
+#include "common/grid2.h"
 #include "common/laser_scan.h"
 #include "common/pose2.h"
 #include "sim/obstacles.h"
@@ -39,14 +40,12 @@ class TrueCoverage {
   double ReachableArea() const;
 
  private:
-  int Index(const Eigen::Vector2d& p_W) const;  // -1 outside the grid
+  // Linear index of the cell holding p_W; -1 outside the grid.
+  int Index(const Eigen::Vector2d& p_W) const;
 
-  double cell_m_;
-  Eigen::Vector2d origin_W_;  // corner of cell (0, 0)
-  int width_ = 0;
-  int height_ = 0;
-  std::vector<std::uint8_t> reachable_;
-  std::vector<std::uint8_t> seen_;
+  GridLimits limits_;
+  Grid2<std::uint8_t> reachable_;
+  Grid2<std::uint8_t> seen_;
   int num_reachable_ = 0;
   int num_seen_reachable_ = 0;
 };

@@ -2,11 +2,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <stdexcept>
 #include <string>
 
 #include "common/angles.h"
+#include "common/grid2.h"
+#include "common/segments.h"
 
 namespace mjslam::eval {
 
@@ -40,10 +43,6 @@ struct Rectangle {
     return std::abs(q.x()) <= half_u + margin && std::abs(q.y()) <= half_v + margin;
   }
 };
-
-double Cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
-  return a.x() * b.y() - a.y() * b.x();
-}
 
 Rectangle MakeRectangle(const WallRectangle& wall, int index, double min_side) {
   const std::string name = "wall " + std::to_string(index);
@@ -187,14 +186,6 @@ std::vector<Piece> BoundarySegments(const std::vector<Rectangle>& rects,
   return segments;
 }
 
-// Intersection of the infinite lines through two pieces (not parallel).
-Eigen::Vector2d Intersect(const Piece& p, const Piece& q) {
-  const Eigen::Vector2d dp = p.b - p.a;
-  const Eigen::Vector2d dq = q.b - q.a;
-  const double t = Cross(q.a - p.a, dq) / Cross(dp, dq);
-  return p.a + t * dp;
-}
-
 }  // namespace
 
 Map BuildGroundTruthMap(const std::vector<WallRectangle>& walls, const GroundTruthParams& params) {
@@ -234,7 +225,9 @@ Map BuildGroundTruthMap(const std::vector<WallRectangle>& walls, const GroundTru
     const double turn = Cross(d_in, d_out);
     if (std::abs(turn) < min_sin) continue;
     // Obstacle on the left: a left turn wraps around the obstacle (convex).
-    corners.push_back({Intersect(segments[i], segments[best]), turn > 0.0, static_cast<int>(i),
+    corners.push_back({LineIntersection(segments[i].a, segments[i].b, segments[best].a,
+                                        segments[best].b),
+                       turn > 0.0, static_cast<int>(i),
                        best});
   }
   // The segments end exactly at their corners.
@@ -295,48 +288,28 @@ Map ReachableFeatures(const Map& truth, const std::vector<WallRectangle>& walls,
   }
   lo.array() -= 2.0 * cell_m;
   hi.array() += 2.0 * cell_m;
-  const int nx = static_cast<int>(std::ceil((hi.x() - lo.x()) / cell_m));
-  const int ny = static_cast<int>(std::ceil((hi.y() - lo.y()) / cell_m));
-  auto index_of = [&](const Eigen::Vector2d& p, int* ix, int* iy) {
-    *ix = static_cast<int>(std::floor((p.x() - lo.x()) / cell_m));
-    *iy = static_cast<int>(std::floor((p.y() - lo.y()) / cell_m));
-    return *ix >= 0 && *iy >= 0 && *ix < nx && *iy < ny;
-  };
+  const GridLimits limits(lo, cell_m, static_cast<int>(std::ceil((hi.x() - lo.x()) / cell_m)),
+                          static_cast<int>(std::ceil((hi.y() - lo.y()) / cell_m)));
+  // A cell is free when its centre is in no wall.
   auto free_cell = [&](int ix, int iy) {
-    const Eigen::Vector2d centre(lo.x() + (ix + 0.5) * cell_m, lo.y() + (iy + 0.5) * cell_m);
+    const Eigen::Vector2d centre = limits.CellCenter(ix, iy);
     for (const Rectangle& r : rects) {
       if (r.Contains(centre, 0.0)) return false;
     }
     return true;
   };
-  int sx = 0;
-  int sy = 0;
-  index_of(p_W_start, &sx, &sy);
-  if (!free_cell(sx, sy)) {
+  const Eigen::Vector2i start = limits.CellOf(p_W_start);
+  if (!free_cell(start.x(), start.y())) {
     throw std::invalid_argument("reachable features: the start point (" +
                                 ValueText(p_W_start.x()) + ", " + ValueText(p_W_start.y()) +
                                 ") is inside a wall");
   }
   // Flood fill, 4-connected.
-  std::vector<char> reached(static_cast<std::size_t>(nx) * ny, 0);
-  std::vector<std::pair<int, int>> stack = {{sx, sy}};
-  reached[static_cast<std::size_t>(sy) * nx + sx] = 1;
-  while (!stack.empty()) {
-    const auto [x, y] = stack.back();
-    stack.pop_back();
-    const int next[4][2] = {{x + 1, y}, {x - 1, y}, {x, y + 1}, {x, y - 1}};
-    for (const auto& n : next) {
-      if (n[0] < 0 || n[1] < 0 || n[0] >= nx || n[1] >= ny) continue;
-      char& r = reached[static_cast<std::size_t>(n[1]) * nx + n[0]];
-      if (r != 0 || !free_cell(n[0], n[1])) continue;
-      r = 1;
-      stack.push_back({n[0], n[1]});
-    }
-  }
+  Grid2<std::uint8_t> reached(limits, 0);
+  FloodFill(start, Connectivity::kFour, free_cell, &reached);
   auto reachable = [&](const Eigen::Vector2d& p) {
-    int ix = 0;
-    int iy = 0;
-    return index_of(p, &ix, &iy) && reached[static_cast<std::size_t>(iy) * nx + ix] != 0;
+    const Eigen::Vector2i cell = limits.CellOf(p);
+    return limits.Contains(cell) && reached(cell.x(), cell.y()) != 0;
   };
   Map kept;
   for (const MapFeature& f : truth) {

@@ -2,9 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <deque>
 
 #include "common/angles.h"
+#include "common/grid2.h"
 
 namespace mjslam::explorer {
 namespace {
@@ -76,43 +76,24 @@ std::vector<Eigen::Vector2d> GlobalFrontierPoints(const OccupancyGrid& grid,
   std::vector<Eigen::Vector2d> points;
   if (w == 0) return points;
   // Frontier cells: free, with an unknown 4-neighbour.
-  std::vector<std::uint8_t> frontier(static_cast<size_t>(w) * h, 0);
+  Grid2<std::uint8_t> frontier(grid.limits(), 0);
   for (int iy = 0; iy < h; ++iy) {
     for (int ix = 0; ix < w; ++ix) {
       if (grid.State(ix, iy) != CellState::kFree) continue;
-      frontier[grid.Index(ix, iy)] = grid.State(ix + 1, iy) == CellState::kUnknown ||
-                                     grid.State(ix - 1, iy) == CellState::kUnknown ||
-                                     grid.State(ix, iy + 1) == CellState::kUnknown ||
-                                     grid.State(ix, iy - 1) == CellState::kUnknown;
+      frontier(ix, iy) = grid.State(ix + 1, iy) == CellState::kUnknown ||
+                         grid.State(ix - 1, iy) == CellState::kUnknown ||
+                         grid.State(ix, iy + 1) == CellState::kUnknown ||
+                         grid.State(ix, iy - 1) == CellState::kUnknown;
     }
   }
   // Clusters (8-connected, breadth first), cut into pieces of about 1 m.
   const int piece_cells = std::max(1, static_cast<int>(std::lround(1.0 / grid.resolution())));
-  std::vector<std::uint8_t> seen(frontier.size(), 0);
+  Grid2<std::uint8_t> seen(grid.limits(), 0);
   for (int start = 0; start < w * h; ++start) {
     if (!frontier[start] || seen[start]) continue;
-    std::vector<int> cluster;
-    std::deque<int> queue = {start};
-    seen[start] = 1;
-    while (!queue.empty()) {
-      const int c = queue.front();
-      queue.pop_front();
-      cluster.push_back(c);
-      const int cx = c % w;
-      const int cy = c / w;
-      for (int dy = -1; dy <= 1; ++dy) {
-        for (int dx = -1; dx <= 1; ++dx) {
-          const int nx = cx + dx;
-          const int ny = cy + dy;
-          if (!grid.Contains(nx, ny)) continue;
-          const int j = grid.Index(nx, ny);
-          if (frontier[j] && !seen[j]) {
-            seen[j] = 1;
-            queue.push_back(j);
-          }
-        }
-      }
-    }
+    const std::vector<int> cluster = FloodFill(
+        grid.limits().CellOfIndex(start), Connectivity::kEight,
+        [&](int ix, int iy) { return frontier(ix, iy) != 0; }, &seen);
     if (static_cast<int>(cluster.size()) < params.min_frontier_cells) continue;
     for (size_t first = 0; first < cluster.size(); first += piece_cells) {
       const size_t last = std::min(cluster.size(), first + piece_cells);

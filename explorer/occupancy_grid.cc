@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
 #include "common/check.h"
 
@@ -17,18 +16,9 @@ constexpr double kMaxGrazingMarginM = 0.3;
 
 }  // namespace
 
-OccupancyGrid::OccupancyGrid(const OccupancyGridSettings& settings) : settings_(settings) {
-  MJSLAM_CHECK(settings_.resolution_m > 0.0);
-}
-
-Eigen::Vector2i OccupancyGrid::CellOf(const Eigen::Vector2d& p_W) const {
-  const Eigen::Vector2d q = (p_W - origin_) / settings_.resolution_m;
-  return {static_cast<int>(std::floor(q.x())), static_cast<int>(std::floor(q.y()))};
-}
-
-Eigen::Vector2d OccupancyGrid::CellCenter(int ix, int iy) const {
-  return origin_ + settings_.resolution_m * Eigen::Vector2d(ix + 0.5, iy + 0.5);
-}
+OccupancyGrid::OccupancyGrid(const OccupancyGridSettings& settings)
+    : settings_(settings),
+      limits_(Eigen::Vector2d::Zero(), settings.resolution_m, 0, 0) {}
 
 double OccupancyGrid::LogOdds(int ix, int iy) const {
   return Contains(ix, iy) ? log_odds_[Index(ix, iy)] : 0.0;
@@ -41,88 +31,64 @@ CellState OccupancyGrid::StateAt(const Eigen::Vector2d& p_W) const {
 
 double OccupancyGrid::KnownFreeArea() const {
   int count = 0;
-  for (int iy = 0; iy < height_; ++iy) {
-    for (int ix = 0; ix < width_; ++ix) count += State(ix, iy) == CellState::kFree;
+  for (int iy = 0; iy < height(); ++iy) {
+    for (int ix = 0; ix < width(); ++ix) count += State(ix, iy) == CellState::kFree;
   }
   return count * settings_.resolution_m * settings_.resolution_m;
 }
 
 void OccupancyGrid::EnsureCovers(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi) {
   const double r = settings_.resolution_m;
-  if (width_ > 0) {
-    const Eigen::Vector2d top = origin_ + r * Eigen::Vector2d(width_, height_);
-    if (lo.x() >= origin_.x() && lo.y() >= origin_.y() && hi.x() < top.x() &&
-        hi.y() < top.y()) {
+  const Eigen::Vector2d origin = limits_.origin();
+  const int width = limits_.width();
+  const int height = limits_.height();
+  if (width > 0) {
+    const Eigen::Vector2d top = limits_.far_corner();
+    if (lo.x() >= origin.x() && lo.y() >= origin.y() && hi.x() < top.x() && hi.y() < top.y()) {
       return;
     }
   }
   // New bounds on the existing cell lattice (origin moves by whole cells).
   Eigen::Vector2d new_lo = lo.array() - kGrowthMarginM;
   Eigen::Vector2d new_hi = hi.array() + kGrowthMarginM;
-  if (width_ > 0) {
-    new_lo = new_lo.cwiseMin(origin_);
-    new_hi = new_hi.cwiseMax(origin_ + r * Eigen::Vector2d(width_, height_));
+  if (width > 0) {
+    new_lo = new_lo.cwiseMin(origin);
+    new_hi = new_hi.cwiseMax(limits_.far_corner());
     const Eigen::Vector2d shift =
-        ((origin_ - new_lo) / r).array().ceil().matrix() * r;  // whole cells
-    new_lo = origin_ - shift;
+        ((origin - new_lo) / r).array().ceil().matrix() * r;  // whole cells
+    new_lo = origin - shift;
   } else {
     new_lo = (new_lo / r).array().floor().matrix() * r;
   }
-  const int new_width = static_cast<int>(std::ceil((new_hi.x() - new_lo.x()) / r)) + 1;
-  const int new_height = static_cast<int>(std::ceil((new_hi.y() - new_lo.y()) / r)) + 1;
-  std::vector<float> grown(static_cast<size_t>(new_width) * new_height, 0.0f);
-  const int dx = static_cast<int>(std::lround((origin_.x() - new_lo.x()) / r));
-  const int dy = static_cast<int>(std::lround((origin_.y() - new_lo.y()) / r));
-  for (int iy = 0; iy < height_; ++iy) {
-    for (int ix = 0; ix < width_; ++ix) {
-      grown[(iy + dy) * new_width + ix + dx] = log_odds_[Index(ix, iy)];
+  const GridLimits grown_limits(
+      new_lo, r, static_cast<int>(std::ceil((new_hi.x() - new_lo.x()) / r)) + 1,
+      static_cast<int>(std::ceil((new_hi.y() - new_lo.y()) / r)) + 1);
+  std::vector<float> grown(static_cast<size_t>(grown_limits.num_cells()), 0.0f);
+  const int dx = static_cast<int>(std::lround((origin.x() - new_lo.x()) / r));
+  const int dy = static_cast<int>(std::lround((origin.y() - new_lo.y()) / r));
+  for (int iy = 0; iy < height; ++iy) {
+    for (int ix = 0; ix < width; ++ix) {
+      grown[grown_limits.Index(ix + dx, iy + dy)] = log_odds_[Index(ix, iy)];
     }
   }
   log_odds_.swap(grown);
-  origin_ = new_lo;
-  width_ = new_width;
-  height_ = new_height;
+  limits_ = grown_limits;
   marks_.assign(log_odds_.size(), 0);
   touched_.clear();
 }
 
-void OccupancyGrid::MarkRayFree(const Eigen::Vector2d& from, const Eigen::Vector2d& to) {
-  // Every cell the segment crosses, once (Amanatides and Woo, "A Fast Voxel
-  // Traversal Algorithm", 1987).
-  const double r = settings_.resolution_m;
-  Eigen::Vector2i cell = CellOf(from);
-  const Eigen::Vector2i last = CellOf(to);
-  const Eigen::Vector2d d = to - from;
-  const int step_x = d.x() > 0 ? 1 : -1;
-  const int step_y = d.y() > 0 ? 1 : -1;
-  const double inf = std::numeric_limits<double>::infinity();
-  const double delta_x = d.x() != 0.0 ? r / std::abs(d.x()) : inf;
-  const double delta_y = d.y() != 0.0 ? r / std::abs(d.y()) : inf;
-  const Eigen::Vector2d corner = origin_ + r * cell.cast<double>();
-  double t_x = d.x() != 0.0
-                   ? ((d.x() > 0 ? corner.x() + r : corner.x()) - from.x()) / d.x()
-                   : inf;
-  double t_y = d.y() != 0.0
-                   ? ((d.y() > 0 ? corner.y() + r : corner.y()) - from.y()) / d.y()
-                   : inf;
-  const int max_steps = std::abs(last.x() - cell.x()) + std::abs(last.y() - cell.y());
-  for (int k = 0; k <= max_steps; ++k) {
-    if (Contains(cell.x(), cell.y())) {
-      const int i = Index(cell.x(), cell.y());
-      if (marks_[i] == 0) {
-        marks_[i] = 1;
-        touched_.push_back(i);
-      }
-    }
-    if (cell == last) break;
-    if (t_x < t_y) {
-      cell.x() += step_x;
-      t_x += delta_x;
-    } else {
-      cell.y() += step_y;
-      t_y += delta_y;
-    }
+void OccupancyGrid::MarkFree(int index) {
+  if (marks_[index] == 0) {
+    marks_[index] = 1;
+    touched_.push_back(index);
   }
+}
+
+void OccupancyGrid::MarkRayFree(const Eigen::Vector2d& from, const Eigen::Vector2d& to) {
+  // Every cell the segment crosses, once.
+  TraverseSegment(limits_, from, to, [this](int ix, int iy) {
+    if (Contains(ix, iy)) MarkFree(Index(ix, iy));
+  });
 }
 
 void OccupancyGrid::ApplyMarks() {
@@ -135,14 +101,12 @@ void OccupancyGrid::ApplyMarks() {
   touched_.clear();
 }
 
-void OccupancyGrid::InsertScan(const LaserScan& scan, const Pose2& X_WS) {
+OccupancyGrid::BeamFreeSpace OccupancyGrid::FreeSpaceOfBeams(const LaserScan& scan) const {
   const int n = scan.size();
-  if (n == 0) return;
   const double r_cell = settings_.resolution_m;
-  // Range up to which each beam proves free space, and whether it ends on an
-  // echo that is inserted as occupied.
-  std::vector<double> free_range(n);
-  std::vector<std::uint8_t> hit(n);
+  BeamFreeSpace beams;
+  beams.free_range_m.resize(n);
+  beams.hit.resize(n);
   auto echo_at = [&](int i) {
     return i >= 0 && i < n && scan.has_return[i] != 0 && scan.ranges_m[i] < scan.max_range_m;
   };
@@ -169,31 +133,41 @@ void OccupancyGrid::InsertScan(const LaserScan& scan, const Pose2& X_WS) {
                                            0.7 * r_cell / std::max(sin_incidence, 1e-3)));
         break;
       }
-      free_range[i] = std::max(0.0, scan.ranges_m[i] - margin);
-      hit[i] = 1;
+      beams.free_range_m[i] = std::max(0.0, scan.ranges_m[i] - margin);
+      beams.hit[i] = 1;
     } else if (echo) {
-      free_range[i] = settings_.max_insert_range_m;
-      hit[i] = 0;
+      beams.free_range_m[i] = settings_.max_insert_range_m;
+      beams.hit[i] = 0;
     } else {
-      free_range[i] = std::min(settings_.no_return_free_range_m, settings_.max_insert_range_m);
-      hit[i] = 0;
+      beams.free_range_m[i] =
+          std::min(settings_.no_return_free_range_m, settings_.max_insert_range_m);
+      beams.hit[i] = 0;
     }
   }
-  // Grow the grid to cover every point the scan touches.
+  return beams;
+}
+
+void OccupancyGrid::CoverScan(const LaserScan& scan, const Pose2& X_WS,
+                              const BeamFreeSpace& beams) {
   const Eigen::Vector2d p_WS = X_WS.translation();
   Eigen::Vector2d lo = p_WS;
   Eigen::Vector2d hi = p_WS;
-  for (int i = 0; i < n; ++i) {
+  for (int i = 0; i < scan.size(); ++i) {
     const double th = X_WS.theta + scan.BeamAngle(i);
-    const double range = hit[i] ? scan.ranges_m[i] : free_range[i];
+    const double range = beams.hit[i] ? scan.ranges_m[i] : beams.free_range_m[i];
     const Eigen::Vector2d p = p_WS + range * Eigen::Vector2d(std::cos(th), std::sin(th));
     lo = lo.cwiseMin(p);
     hi = hi.cwiseMax(p);
   }
   EnsureCovers(lo, hi);
+}
 
-  // Free space along each beam and, with sub-rays, between consecutive beams
-  // up to the shorter of their free ranges.
+void OccupancyGrid::MarkScanFree(const LaserScan& scan, const Pose2& X_WS,
+                                 const BeamFreeSpace& beams) {
+  const int n = scan.size();
+  const double r_cell = settings_.resolution_m;
+  const Eigen::Vector2d p_WS = X_WS.translation();
+  const std::vector<double>& free_range = beams.free_range_m;
   for (int i = 0; i < n; ++i) {
     const double th = X_WS.theta + scan.BeamAngle(i);
     MarkRayFree(p_WS, p_WS + free_range[i] * Eigen::Vector2d(std::cos(th), std::sin(th)));
@@ -207,9 +181,13 @@ void OccupancyGrid::InsertScan(const LaserScan& scan, const Pose2& X_WS) {
       MarkRayFree(p_WS, p_WS + range * Eigen::Vector2d(std::cos(th_k), std::sin(th_k)));
     }
   }
-  // Echoes: occupied wins over free within one scan.
-  for (int i = 0; i < n; ++i) {
-    if (!hit[i]) continue;
+}
+
+void OccupancyGrid::MarkEchoesOccupied(const LaserScan& scan, const Pose2& X_WS,
+                                       const BeamFreeSpace& beams) {
+  const Eigen::Vector2d p_WS = X_WS.translation();
+  for (int i = 0; i < scan.size(); ++i) {
+    if (!beams.hit[i]) continue;
     const double th = X_WS.theta + scan.BeamAngle(i);
     const Eigen::Vector2i c =
         CellOf(p_WS + scan.ranges_m[i] * Eigen::Vector2d(std::cos(th), std::sin(th)));
@@ -218,6 +196,14 @@ void OccupancyGrid::InsertScan(const LaserScan& scan, const Pose2& X_WS) {
     if (marks_[index] == 0) touched_.push_back(index);
     marks_[index] = 2;
   }
+}
+
+void OccupancyGrid::InsertScan(const LaserScan& scan, const Pose2& X_WS) {
+  if (scan.size() == 0) return;
+  const BeamFreeSpace beams = FreeSpaceOfBeams(scan);
+  CoverScan(scan, X_WS, beams);
+  MarkScanFree(scan, X_WS, beams);
+  MarkEchoesOccupied(scan, X_WS, beams);
   ApplyMarks();
 }
 
@@ -240,11 +226,7 @@ void OccupancyGrid::MarkRectangleFree(const Pose2& X_WB, double x0_m, double x1_
     for (int ix = c0.x(); ix <= c1.x(); ++ix) {
       const Eigen::Vector2d p_B = X_BW * CellCenter(ix, iy);
       if (p_B.x() < x0_m || p_B.x() > x1_m || std::abs(p_B.y()) > half_width_m) continue;
-      const int i = Index(ix, iy);
-      if (marks_[i] == 0) {
-        marks_[i] = 1;
-        touched_.push_back(i);
-      }
+      MarkFree(Index(ix, iy));
     }
   }
   ApplyMarks();

@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 
+#include "common/grid2.h"
 #include "common/laser_scan.h"
 #include "common/pose2.h"
 
@@ -54,24 +55,24 @@ class OccupancyGrid {
   /// own body stands there, so it is not an obstacle.
   void MarkRectangleFree(const Pose2& X_WB, double x0_m, double x1_m, double half_width_m);
 
+  /// The grid's limits (no cells before the first insertion).
+  const GridLimits& limits() const { return limits_; }
   /// Cell size, metres.
   double resolution() const { return settings_.resolution_m; }
   /// Grid size in cells (0 before the first insertion).
-  int width() const { return width_; }
-  int height() const { return height_; }
+  int width() const { return limits_.width(); }
+  int height() const { return limits_.height(); }
   /// World coordinates of the corner of cell (0, 0), metres.
-  Eigen::Vector2d origin() const { return origin_; }
+  Eigen::Vector2d origin() const { return limits_.origin(); }
 
   /// True when (ix, iy) lies inside the grid.
-  bool Contains(int ix, int iy) const {
-    return ix >= 0 && iy >= 0 && ix < width_ && iy < height_;
-  }
+  bool Contains(int ix, int iy) const { return limits_.Contains(ix, iy); }
   /// Linear index of cell (ix, iy), which must be inside.
-  int Index(int ix, int iy) const { return iy * width_ + ix; }
+  int Index(int ix, int iy) const { return limits_.Index(ix, iy); }
   /// Cell containing the world point `p_W` (may be outside the grid).
-  Eigen::Vector2i CellOf(const Eigen::Vector2d& p_W) const;
+  Eigen::Vector2i CellOf(const Eigen::Vector2d& p_W) const { return limits_.CellOf(p_W); }
   /// World coordinates of the centre of cell (ix, iy).
-  Eigen::Vector2d CellCenter(int ix, int iy) const;
+  Eigen::Vector2d CellCenter(int ix, int iy) const { return limits_.CellCenter(ix, iy); }
 
   /// Log-odds of a cell; 0 (unknown) outside the grid.
   double LogOdds(int ix, int iy) const;
@@ -90,18 +91,36 @@ class OccupancyGrid {
   double KnownFreeArea() const;
 
  private:
+  // Per beam of a scan: the range up to which it proves free space, and
+  // whether it ends on an echo that is inserted as occupied.
+  struct BeamFreeSpace {
+    std::vector<double> free_range_m;
+    std::vector<std::uint8_t> hit;
+  };
+
+  // The free range and echo flag of every beam of `scan`.
+  BeamFreeSpace FreeSpaceOfBeams(const LaserScan& scan) const;
+  // Grows the grid to cover every point the scan touches (its echoes and
+  // the ends of its free parts) seen from the laser at `X_WS`.
+  void CoverScan(const LaserScan& scan, const Pose2& X_WS, const BeamFreeSpace& beams);
+  // Marks the free space along each beam and, with sub-rays, between
+  // consecutive beams up to the shorter of their free ranges.
+  void MarkScanFree(const LaserScan& scan, const Pose2& X_WS, const BeamFreeSpace& beams);
+  // Marks the cells of the echoes occupied (occupied wins over free within
+  // one scan).
+  void MarkEchoesOccupied(const LaserScan& scan, const Pose2& X_WS, const BeamFreeSpace& beams);
   // Grows the grid so that it covers the axis-aligned box [lo, hi] (world).
   void EnsureCovers(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi);
   // Marks every cell the segment from `from` to `to` crosses (both ends
   // included) for a free update in this scan.
   void MarkRayFree(const Eigen::Vector2d& from, const Eigen::Vector2d& to);
+  // Marks cell `index` for a free update unless it is marked already.
+  void MarkFree(int index);
   // Applies the marks of this scan and clears them.
   void ApplyMarks();
 
   OccupancyGridSettings settings_;
-  Eigen::Vector2d origin_ = Eigen::Vector2d::Zero();
-  int width_ = 0;
-  int height_ = 0;
+  GridLimits limits_;
   std::vector<float> log_odds_;
   // Per-scan update marks: 0 none, 1 free, 2 occupied; `touched_` lists the
   // marked cells.

@@ -9,6 +9,7 @@
 
 #include "common/angles.h"
 #include "common/check.h"
+#include "common/segments.h"
 
 namespace mjslam::explorer {
 namespace {
@@ -56,10 +57,6 @@ void DistanceTransform1d(const std::vector<double>& f, int n, std::vector<double
 
 Eigen::Vector2d LeftNormal(const Eigen::Vector2d& u) { return {-u.y(), u.x()}; }
 
-double Cross(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
-  return a.x() * b.y() - a.y() * b.x();
-}
-
 // Appends points every `step` along the segment [a, b) (b excluded).
 void AppendSegment(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double step, Path* path) {
   const double length = (b - a).norm();
@@ -82,9 +79,9 @@ NavigationMap::NavigationMap(const OccupancyGrid& grid, const ExplorerParams& pa
   const int w = grid_.width();
   const int h = grid_.height();
   const int n = w * h;
-  clearance_.assign(n, 0.0f);
-  cost_.assign(n, kInfinity);
-  parent_.assign(n, -1);
+  clearance_ = Grid2<float>(grid_.limits(), 0.0f);
+  cost_ = Grid2<double>(grid_.limits(), kInfinity);
+  parent_ = Grid2<int>(grid_.limits(), -1);
   if (n == 0) return;
 
   // Clearance: exact Euclidean distance transform of the occupied cells,
@@ -116,12 +113,12 @@ NavigationMap::NavigationMap(const OccupancyGrid& grid, const ExplorerParams& pa
   // Dijkstra from the start cell, ties broken by cell index (deterministic).
   if (!grid_.Contains(start_.x(), start_.y())) return;
   escape_ = !Comfortable(start_.x(), start_.y());
-  traversable_.assign(n, 0);
+  traversable_ = Grid2<std::uint8_t>(grid_.limits(), 0);
   for (int iy = 0; iy < h; ++iy) {
-    for (int ix = 0; ix < w; ++ix) traversable_[iy * w + ix] = TraversableSlow(ix, iy);
+    for (int ix = 0; ix < w; ++ix) traversable_(ix, iy) = TraversableSlow(ix, iy);
   }
   auto traversable = [&](int ix, int iy) {
-    return ix >= 0 && iy >= 0 && ix < w && iy < h && traversable_[iy * w + ix] != 0;
+    return grid_.Contains(ix, iy) && traversable_(ix, iy) != 0;
   };
   const double r = grid_.resolution();
   using Entry = std::pair<double, int>;
@@ -135,8 +132,9 @@ NavigationMap::NavigationMap(const OccupancyGrid& grid, const ExplorerParams& pa
     const auto [cost, index] = open.top();
     open.pop();
     if (cost > cost_[index]) continue;
-    const int ix = index % w;
-    const int iy = index / w;
+    const Eigen::Vector2i cell = grid_.limits().CellOfIndex(index);
+    const int ix = cell.x();
+    const int iy = cell.y();
     for (int k = 0; k < 8; ++k) {
       const int jx = ix + dx[k];
       const int jy = iy + dy[k];
@@ -172,7 +170,7 @@ double NavigationMap::ClearanceAt(const Eigen::Vector2d& p_W) const {
 
 bool NavigationMap::Traversable(int ix, int iy) const {
   if (!grid_.Contains(ix, iy)) return false;
-  if (!traversable_.empty()) return traversable_[grid_.Index(ix, iy)] != 0;
+  if (!traversable_.cells().empty()) return traversable_[grid_.Index(ix, iy)] != 0;
   return TraversableSlow(ix, iy);
 }
 
@@ -215,7 +213,7 @@ std::vector<Eigen::Vector2i> NavigationMap::CellPath(const Eigen::Vector2i& goal
   std::vector<Eigen::Vector2i> cells;
   if (!std::isfinite(CostTo(goal.x(), goal.y()))) return cells;
   for (int i = grid_.Index(goal.x(), goal.y()); i >= 0; i = parent_[i]) {
-    cells.emplace_back(i % grid_.width(), i / grid_.width());
+    cells.push_back(grid_.limits().CellOfIndex(i));
   }
   std::reverse(cells.begin(), cells.end());
   return cells;

@@ -5,6 +5,7 @@
 
 #include <Eigen/Core>
 
+#include "common/grid2.h"
 #include "explorer/explorer_params.h"
 #include "explorer/occupancy_grid.h"
 
@@ -78,11 +79,13 @@ class NavigationMap {
   Eigen::Vector2i start_;
   // Whether the escape rule applies (the start lacks clearance).
   bool escape_ = false;
-  std::vector<float> clearance_;
-  // Traversable() of every cell, computed once.
-  std::vector<std::uint8_t> traversable_;
-  std::vector<double> cost_;
-  std::vector<int> parent_;
+  // Per cell of the grid: clearance, metres; Traversable(), computed once
+  // (no cells when the start is outside the grid); path cost, metres; the
+  // linear index of the cell before it on its cheapest path (-1: none).
+  Grid2<float> clearance_;
+  Grid2<std::uint8_t> traversable_;
+  Grid2<double> cost_;
+  Grid2<int> parent_;
 };
 
 /// Plans a kinematically feasible path of h from the map's start to

@@ -22,12 +22,12 @@ eval::Map ReadMapCsv(const std::string& path) {
     const std::vector<double>& row = table.rows[r];
     const std::string& kind = table.text[r][0];  // the only text column
     const std::string where = path + ":" + std::to_string(r + 2) + ": ";
-    eval::MapFeature f;
+    MapFeature f;
     f.id = static_cast<int>(row[id]);
     if (kind == "line") {
-      f.type = eval::MapFeature::Type::kLine;
+      f.type = MapFeature::Type::kLine;
     } else if (kind == "corner") {
-      f.type = eval::MapFeature::Type::kCorner;
+      f.type = MapFeature::Type::kCorner;
     } else {
       throw std::runtime_error(where + "type: expected line or corner (got '" + kind + "')");
     }
@@ -36,7 +36,7 @@ eval::Map ReadMapCsv(const std::string& path) {
     if (!f.params.allFinite() || !f.covariance.allFinite()) {
       throw std::runtime_error(where + "p0, p1, c00, c01, c11: expected numbers");
     }
-    f.has_segment = f.type == eval::MapFeature::Type::kLine && std::isfinite(row[ax]) &&
+    f.has_segment = f.type == MapFeature::Type::kLine && std::isfinite(row[ax]) &&
                     std::isfinite(row[ax + 1]) && std::isfinite(row[ax + 2]) &&
                     std::isfinite(row[ax + 3]);
     if (f.has_segment) {
@@ -50,8 +50,8 @@ eval::Map ReadMapCsv(const std::string& path) {
 
 void WriteMapCsv(const std::string& path, const eval::Map& map) {
   std::string text = HeaderLine(MapColumns());
-  for (const eval::MapFeature& f : map) {
-    const bool line = f.type == eval::MapFeature::Type::kLine;
+  for (const MapFeature& f : map) {
+    const bool line = f.type == MapFeature::Type::kLine;
     text += std::to_string(f.id) + (line ? ",line," : ",corner,");
     for (const double v : {f.params.x(), f.params.y(), f.covariance(0, 0), f.covariance(0, 1),
                            f.covariance(1, 1)}) {

@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 
+#include "common/map_feature.h"
 #include "common/pose2.h"
 #include "common/records.h"
 #include "slam/corrections.h"
@@ -48,27 +49,6 @@ struct StepReport {
   /// Observations neither matched nor added (lost a contest for a feature,
   /// or between the gate and the new-feature threshold).
   int num_ambiguous = 0;
-};
-
-/// A map feature as the filter estimates it, for maps and metrics.
-struct MapFeature {
-  /// The feature kinds: Type::kLine, Type::kCorner.
-  using Type = FeatureType;
-  /// Stable id, in order of creation from 0.
-  int id = 0;
-  /// Line or corner.
-  Type type = Type::kLine;
-  /// (r, al) in W in canonical form (r >= 0, al in (-pi, pi]) for a line;
-  /// (x, y) of the corner in W. Metres, radians.
-  Eigen::Vector2d params = Eigen::Vector2d::Zero();
-  /// Marginal covariance of `params` (the 2x2 block of P).
-  Eigen::Matrix2d covariance = Eigen::Matrix2d::Zero();
-  /// True for lines: the secondary map's seen segment from p_WA to p_WB
-  /// (metres, in W), on the current line estimate. False (and zero points)
-  /// for corners.
-  bool has_segment = false;
-  Eigen::Vector2d p_WA = Eigen::Vector2d::Zero();
-  Eigen::Vector2d p_WB = Eigen::Vector2d::Zero();
 };
 
 /// Bad data given to the filter (a non-finite record, a negative dt, an

@@ -3,15 +3,11 @@
 #include <Eigen/Core>
 
 #include "common/angles.h"
+#include "common/map_feature.h"
 #include "common/pose2.h"
 #include "slam/fast_wrap.h"
 
 namespace mjslam::slam {
-
-/// The two kinds of map feature, each two numbers in the state: a line
-/// (r, al) in polar form in W (x cos al + y sin al = r, r >= 0, al wrapped),
-/// or a corner point p_WC = (x_e, y_e).
-enum class FeatureType { kLine, kCorner };
 
 /// Observation models of the paper (Eqs. 7 and 8), composed with the laser
 /// mount: the models are written for the sensor frame S, whose pose is

@@ -134,5 +134,26 @@ TEST(LayeringTest, ClosedLoopWritesNoFilesAndDoesNotRender) {
   }
 }
 
+// The shared test fixtures (tests/support/) stand in for the simulator: they
+// may use common/ (and slam/'s observation types for the synthetic feature
+// world), but no MuJoCo, yaml-cpp or GL, and no other project folder.
+TEST(LayeringTest, TestSupportIncludesOnlyCommonAndSlam) {
+  const Rule rule{{"common", "slam"}, false, false, false, true};
+  EXPECT_EQ(Violations("#include \"explorer/occupancy_grid.h\"\n", rule).size(), 1u);
+  const fs::path folder = fs::path(MJSLAM_SOURCE_DIR) / "tests" / "support";
+  int files = 0;
+  for (const auto& entry : fs::directory_iterator(folder)) {
+    if (entry.path().extension() != ".h") continue;
+    std::ifstream in(entry.path());
+    std::stringstream text;
+    text << in.rdbuf();
+    ++files;
+    for (const std::string& header : Violations(text.str(), rule)) {
+      ADD_FAILURE() << entry.path() << " includes " << header << ", which tests/support/ may not";
+    }
+  }
+  EXPECT_GE(files, 5);
+}
+
 }  // namespace
 }  // namespace mjslam

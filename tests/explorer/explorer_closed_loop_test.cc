@@ -13,8 +13,8 @@
 
 #include "common/angles.h"
 #include "explorer/explorer.h"
-#include "tests/explorer/kinematic_sim.h"
-#include "tests/explorer/seen_area.h"
+#include "tests/support/kinematic_sim.h"
+#include "tests/support/seen_area.h"
 
 namespace mjslam::explorer {
 namespace {

@@ -14,8 +14,9 @@
 #include <gtest/gtest.h>
 
 #include "explorer/explorer.h"
-#include "tests/explorer/seen_area.h"
-#include "tests/explorer/world_walls.h"
+#include "tests/support/kinematic_sim.h"
+#include "tests/support/seen_area.h"
+#include "tests/support/world_walls.h"
 
 namespace mjslam::explorer {
 namespace {

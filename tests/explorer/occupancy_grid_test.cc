@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "explorer/occupancy_grid.h"
-#include "tests/explorer/kinematic_sim.h"
+#include "tests/support/kinematic_sim.h"
 
 namespace mjslam::explorer {
 namespace {

@@ -2,19 +2,14 @@
 
 #include <gtest/gtest.h>
 
+#include "common/segments.h"
 #include "explorer/path_planner.h"
-#include "tests/explorer/kinematic_sim.h"
+#include "tests/support/kinematic_sim.h"
 
 namespace mjslam::explorer {
 namespace {
 
 using testing::Wall;
-
-double DistanceToSegment(const Eigen::Vector2d& p, const Wall& wall) {
-  const Eigen::Vector2d e = wall.b - wall.a;
-  const double t = std::clamp((p - wall.a).dot(e) / e.squaredNorm(), 0.0, 1.0);
-  return (wall.a + t * e - p).norm();
-}
 
 // An L-shaped corridor, 2 m wide: along x from (0, 0) to (6, 2), then up
 // along y from (4, 2) to (6, 8).
@@ -83,7 +78,7 @@ TEST(PathPlannerTest, PathAroundACornerIsFeasibleAndCollisionFree) {
   // Clear of the true walls by the clearance (less one cell for the grid).
   for (const PathPoint& p : path) {
     for (const Wall& wall : LCorridor()) {
-      EXPECT_GE(DistanceToSegment(p.p_W, wall), params.clearance_m - grid.resolution())
+      EXPECT_GE(PointSegmentDistance(p.p_W, wall.a, wall.b), params.clearance_m - grid.resolution())
           << p.p_W.transpose();
     }
   }

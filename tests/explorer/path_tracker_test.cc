@@ -5,7 +5,7 @@
 
 #include "explorer/explorer.h"
 #include "explorer/path_tracker.h"
-#include "tests/explorer/kinematic_sim.h"
+#include "tests/support/kinematic_sim.h"
 
 namespace mjslam::explorer {
 namespace {

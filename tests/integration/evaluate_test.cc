@@ -48,8 +48,8 @@ TEST(EvaluateTest, WritesGroundTruthAndMergesMetricsIntoSummary) {
   // The room seen from inside: 4 lines (rho 3 or 4) and 4 corners.
   const eval::Map truth = rundir::ReadMapCsv(dir + "/ground_truth_map.csv");
   ASSERT_EQ(truth.size(), 8u);
-  for (const eval::MapFeature& f : truth) {
-    if (f.type == eval::MapFeature::Type::kLine) {
+  for (const MapFeature& f : truth) {
+    if (f.type == MapFeature::Type::kLine) {
       EXPECT_TRUE(std::abs(f.params.x() - 3.0) < 1e-9 || std::abs(f.params.x() - 4.0) < 1e-9)
           << f.params.transpose();
     } else {

@@ -8,19 +8,13 @@
 
 #include "app/evaluate.h"
 #include "app/run_config.h"
+#include "common/segments.h"
 #include "sim/obstacles.h"
 #include "sim/scene.h"
 #include "tests/integration/run_helpers.h"
 
 namespace mjslam::testing {
 namespace {
-
-// Distance from p to the segment a-b.
-double SegmentDistance(const Eigen::Vector2d& p, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
-  const Eigen::Vector2d d = b - a;
-  const double t = std::clamp((p - a).dot(d) / d.squaredNorm(), 0.0, 1.0);
-  return (a + t * d - p).norm();
-}
 
 class GroundTruthWorldTest : public ::testing::TestWithParam<std::string> {};
 
@@ -42,8 +36,8 @@ TEST_P(GroundTruthWorldTest, EveryEchoLiesOnATrueSegmentOrAPillar) {
   // Every true line's segment lies on its (r, al) line; every corner is the
   // end of two segments.
   int corners = 0;
-  for (const eval::MapFeature& f : truth) {
-    if (f.type == eval::MapFeature::Type::kLine) {
+  for (const MapFeature& f : truth) {
+    if (f.type == MapFeature::Type::kLine) {
       const Eigen::Vector2d n(std::cos(f.params.y()), std::sin(f.params.y()));
       EXPECT_NEAR(n.dot(f.p_WA), f.params.x(), 1e-9);
       EXPECT_NEAR(n.dot(f.p_WB), f.params.x(), 1e-9);
@@ -51,8 +45,8 @@ TEST_P(GroundTruthWorldTest, EveryEchoLiesOnATrueSegmentOrAPillar) {
     }
     ++corners;
     int ends = 0;
-    for (const eval::MapFeature& g : truth) {
-      if (g.type != eval::MapFeature::Type::kLine) continue;
+    for (const MapFeature& g : truth) {
+      if (g.type != MapFeature::Type::kLine) continue;
       if ((g.p_WA - f.params).norm() < 1e-9 || (g.p_WB - f.params).norm() < 1e-9) ++ends;
     }
     EXPECT_EQ(ends, 2) << "corner at " << f.params.transpose();
@@ -75,9 +69,9 @@ TEST_P(GroundTruthWorldTest, EveryEchoLiesOnATrueSegmentOrAPillar) {
       const Eigen::Vector2d p_W = X_WS * Eigen::Vector2d(range * std::cos(bearing), range * std::sin(bearing));
       if (!pillars.empty() && sim::DistanceToObstacles(p_W, pillars) < 0.03) continue;
       double nearest = std::numeric_limits<double>::infinity();
-      for (const eval::MapFeature& f : truth) {
-        if (f.type == eval::MapFeature::Type::kLine) {
-          nearest = std::min(nearest, SegmentDistance(p_W, f.p_WA, f.p_WB));
+      for (const MapFeature& f : truth) {
+        if (f.type == MapFeature::Type::kLine) {
+          nearest = std::min(nearest, PointSegmentDistance(p_W, f.p_WA, f.p_WB));
         }
       }
       ++echoes;

@@ -10,17 +10,17 @@ namespace mjslam::rundir {
 namespace {
 
 TEST(MapCsvTest, MapRoundTripsBitForBit) {
-  eval::MapFeature line;
+  MapFeature line;
   line.id = 3;
-  line.type = eval::MapFeature::Type::kLine;
+  line.type = MapFeature::Type::kLine;
   line.params = {2.0 / 3.0, -0.1};
   line.covariance << 1e-6, 2e-7, 2e-7, 3e-8;
   line.has_segment = true;
   line.p_WA = {0.1, 1.0 / 7.0};
   line.p_WB = {-4.0, 0.7};
-  eval::MapFeature corner;
+  MapFeature corner;
   corner.id = 8;
-  corner.type = eval::MapFeature::Type::kCorner;
+  corner.type = MapFeature::Type::kCorner;
   corner.params = {1.25, -3.5};
   corner.covariance << 4e-4, -1e-5, -1e-5, 9e-4;
 
@@ -30,14 +30,14 @@ TEST(MapCsvTest, MapRoundTripsBitForBit) {
   const eval::Map map = ReadMapCsv(path);
   ASSERT_EQ(map.size(), 2u);
   EXPECT_EQ(map[0].id, 3);
-  EXPECT_EQ(map[0].type, eval::MapFeature::Type::kLine);
+  EXPECT_EQ(map[0].type, MapFeature::Type::kLine);
   EXPECT_EQ(map[0].params, line.params);
   EXPECT_EQ(map[0].covariance, line.covariance);
   EXPECT_TRUE(map[0].has_segment);
   EXPECT_EQ(map[0].p_WA, line.p_WA);
   EXPECT_EQ(map[0].p_WB, line.p_WB);
   EXPECT_EQ(map[1].id, 8);
-  EXPECT_EQ(map[1].type, eval::MapFeature::Type::kCorner);
+  EXPECT_EQ(map[1].type, MapFeature::Type::kCorner);
   EXPECT_EQ(map[1].params, corner.params);
   EXPECT_EQ(map[1].covariance, corner.covariance);
   EXPECT_FALSE(map[1].has_segment);

@@ -1,7 +1,7 @@
 // Statistical consistency of both filters on a synthetic world: a robot
 // driven by Eq. (6) with noisy inputs around a pillar in a room, observing
 // walls and corners computed from the true geometry plus Gaussian noise
-// (tests/slam/synthetic_world.h). Checks the 2-sigma coverage of the pose
+// (tests/support/synthetic_world.h). Checks the 2-sigma coverage of the pose
 // errors and the Monte Carlo average NEES against chi-square bounds, and that
 // the same check fails when the measurement noise is understated 10x.
 
@@ -17,7 +17,7 @@
 #include "common/rng.h"
 #include "slam/ekf_slam.h"
 #include "slam/motion_model.h"
-#include "tests/slam/synthetic_world.h"
+#include "tests/support/synthetic_world.h"
 
 namespace mjslam::slam {
 namespace {

@@ -15,6 +15,7 @@
 #include "common/laser_scan.h"
 #include "common/pose2.h"
 #include "common/rng.h"
+#include "tests/support/walls.h"
 
 namespace mjslam::slam {
 namespace {
@@ -22,11 +23,7 @@ namespace {
 // ---------------------------------------------------------------------------
 // Synthetic scans: analytic ray-segment intersection in the world frame W.
 
-// A wall from `a` to `b` in W, metres.
-struct Wall {
-  Eigen::Vector2d a;
-  Eigen::Vector2d b;
-};
+using testing::Wall;
 
 // The beam noise of a synthetic scan (0: exact).
 struct BeamNoise {
@@ -62,21 +59,9 @@ SyntheticScan CastScan(const std::vector<Wall>& walls, const Pose2& X_WS,
     if (noise.bearing_std_rad > 0.0) bearing += rng->Gaussian(0.0, noise.bearing_std_rad);
     const Eigen::Vector2d direction(std::cos(X_WS.theta + bearing),
                                     std::sin(X_WS.theta + bearing));
-    double nearest = std::numeric_limits<double>::infinity();
-    int nearest_wall = -1;
-    for (int k = 0; k < static_cast<int>(walls.size()); ++k) {
-      // origin + t direction = a + u (b - a), t > 0, u in [0, 1].
-      const Eigen::Vector2d edge = walls[k].b - walls[k].a;
-      const Eigen::Vector2d offset = walls[k].a - origin;
-      const double denominator = direction.x() * (-edge.y()) - direction.y() * (-edge.x());
-      if (std::abs(denominator) < 1e-15) continue;
-      const double t = (offset.x() * (-edge.y()) - offset.y() * (-edge.x())) / denominator;
-      const double u = (direction.x() * offset.y() - direction.y() * offset.x()) / denominator;
-      if (t > 0.0 && u >= 0.0 && u <= 1.0 && t < nearest) {
-        nearest = t;
-        nearest_wall = k;
-      }
-    }
+    const testing::RayHit hit = testing::CastRayHit(walls, origin, direction, 1e-15);
+    const double nearest = hit.range_m;
+    const int nearest_wall = hit.wall;
     if (nearest_wall < 0 || nearest > max_range_m) continue;
     double range = nearest;
     if (noise.range_std_m > 0.0) range += rng->Gaussian(0.0, noise.range_std_m);
@@ -99,16 +84,7 @@ std::vector<Wall> Polygon(const std::vector<Eigen::Vector2d>& corners) {
 // The true polar line (rho, alpha) of a wall, in the sensor frame S.
 Eigen::Vector2d TrueLineInSensor(const Wall& wall, const Pose2& X_WS) {
   const Pose2 X_SW = X_WS.Inverse();
-  const Eigen::Vector2d a = X_SW * wall.a;
-  const Eigen::Vector2d b = X_SW * wall.b;
-  const Eigen::Vector2d direction = (b - a).normalized();
-  Eigen::Vector2d normal(-direction.y(), direction.x());
-  double rho = normal.dot(a);
-  if (rho < 0.0) {
-    rho = -rho;
-    normal = -normal;
-  }
-  return {rho, std::atan2(normal.y(), normal.x())};
+  return testing::PolarLineThrough(X_SW * wall.a, X_SW * wall.b);
 }
 
 // Normalised innovation squared of an estimate of (a, angle) against the truth.

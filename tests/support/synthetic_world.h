@@ -14,14 +14,9 @@
 #include "common/pose2.h"
 #include "common/rng.h"
 #include "slam/observations.h"
+#include "tests/support/walls.h"
 
-namespace mjslam::slam::testing {
-
-/// A wall from `a` to `b` in W, metres.
-struct Wall {
-  Eigen::Vector2d a;
-  Eigen::Vector2d b;
-};
+namespace mjslam::testing {
 
 /// Walls and corners in W.
 struct SyntheticWorld {
@@ -64,11 +59,11 @@ inline SyntheticWorld RoomWithPillar(double width, double height, double x0, dou
 /// front of the sensor (x_S > 0.1) within range, and every wall with a part in
 /// front within range (the part in front, clipped, gives the endpoints).
 /// Occlusion is ignored. With `rng` null the observations are exact.
-inline ScanFeatures ObserveWorld(const SyntheticWorld& world, const Pose2& X_WS,
+inline slam::ScanFeatures ObserveWorld(const SyntheticWorld& world, const Pose2& X_WS,
                                  const ObservationNoise& noise, Rng* rng) {
   const Pose2 X_SW = X_WS.Inverse();
   const auto draw = [rng](double std) { return rng == nullptr ? 0.0 : rng->Gaussian(0.0, std); };
-  ScanFeatures features;
+  slam::ScanFeatures features;
   for (const Wall& wall : world.walls) {
     Eigen::Vector2d p_SA = X_SW * wall.a;
     Eigen::Vector2d p_SB = X_SW * wall.b;
@@ -79,16 +74,10 @@ inline ScanFeatures ObserveWorld(const SyntheticWorld& world, const Pose2& X_WS,
     if (p_SB.x() < kFront) p_SB = p_SA + (p_SB - p_SA) * (p_SA.x() - kFront) / (p_SA.x() - p_SB.x());
     if (std::min(p_SA.norm(), p_SB.norm()) > noise.max_range_m) continue;
     // The line through the two points, in polar form with rho >= 0.
-    const Eigen::Vector2d direction = (p_SB - p_SA).normalized();
-    Eigen::Vector2d normal(-direction.y(), direction.x());
-    double rho = normal.dot(p_SA);
-    if (rho < 0.0) {
-      normal = -normal;
-      rho = -rho;
-    }
-    LineObservation line;
-    line.rho_m = rho + draw(noise.rho_std_m);
-    line.alpha_rad = WrapAngle(std::atan2(normal.y(), normal.x()) + draw(noise.alpha_std_rad));
+    const Eigen::Vector2d polar = PolarLineThrough(p_SA, p_SB);
+    slam::LineObservation line;
+    line.rho_m = polar[0] + draw(noise.rho_std_m);
+    line.alpha_rad = WrapAngle(polar[1] + draw(noise.alpha_std_rad));
     if (line.rho_m < 0.0) {
       line.rho_m = -line.rho_m;
       line.alpha_rad = WrapAngle(line.alpha_rad + kPi);
@@ -104,7 +93,7 @@ inline ScanFeatures ObserveWorld(const SyntheticWorld& world, const Pose2& X_WS,
   for (const Eigen::Vector2d& p_WC : world.corners) {
     const Eigen::Vector2d p_SC = X_SW * p_WC;
     if (p_SC.x() < 0.1 || p_SC.norm() > noise.max_range_m) continue;
-    CornerObservation corner;
+    slam::CornerObservation corner;
     corner.range_m = p_SC.norm() + draw(noise.range_std_m);
     corner.bearing_rad = WrapAngle(std::atan2(p_SC.y(), p_SC.x()) + draw(noise.bearing_std_rad));
     corner.covariance = noise.reported_variance_scale *
@@ -118,4 +107,4 @@ inline ScanFeatures ObserveWorld(const SyntheticWorld& world, const Pose2& X_WS,
   return features;
 }
 
-}  // namespace mjslam::slam::testing
+}  // namespace mjslam::testing

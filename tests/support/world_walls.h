@@ -17,9 +17,9 @@
 
 #include "common/angles.h"
 #include "common/pose2.h"
-#include "tests/explorer/kinematic_sim.h"
+#include "tests/support/walls.h"
 
-namespace mjslam::explorer::testing {
+namespace mjslam::testing {
 
 struct WorldWalls {
   std::vector<Wall> walls;
@@ -88,4 +88,4 @@ inline WorldWalls ReadWorldWalls(const std::string& path) {
   return world;
 }
 
-}  // namespace mjslam::explorer::testing
+}  // namespace mjslam::testing

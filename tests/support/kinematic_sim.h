@@ -2,8 +2,9 @@
 
 // A test-only kinematic simulator for the explorer: the unicycle motion of
 // the Pioneer's axle (frame R is the point h, `a` ahead of it), a laser cast
-// exactly against wall segments, and a contact check of the body rectangle
-// against the walls. No MuJoCo: the explorer is tested on its own.
+// exactly against wall segments (tests/support/walls.h), and a contact check
+// of the body rectangle against the walls. No MuJoCo: the explorer is tested
+// on its own.
 
 #include <algorithm>
 #include <cmath>
@@ -15,55 +16,9 @@
 #include "common/laser_scan.h"
 #include "common/pose2.h"
 #include "common/records.h"
+#include "tests/support/walls.h"
 
-namespace mjslam::explorer::testing {
-
-/// A wall of zero thickness from `a` to `b`, in W.
-struct Wall {
-  Eigen::Vector2d a;
-  Eigen::Vector2d b;
-};
-
-/// Range along the ray p + t u (|u| = 1) to the first wall, or infinity.
-inline double CastRay(const std::vector<Wall>& walls, const Eigen::Vector2d& p,
-                      const Eigen::Vector2d& u) {
-  double best = std::numeric_limits<double>::infinity();
-  for (const Wall& wall : walls) {
-    const Eigen::Vector2d e = wall.b - wall.a;
-    const double denominator = u.x() * e.y() - u.y() * e.x();
-    if (std::abs(denominator) < 1e-12) continue;
-    const Eigen::Vector2d d = wall.a - p;
-    const double t = (d.x() * e.y() - d.y() * e.x()) / denominator;
-    const double s = (d.x() * u.y() - d.y() * u.x()) / denominator;
-    if (t > 0.0 && s >= 0.0 && s <= 1.0) best = std::min(best, t);
-  }
-  return best;
-}
-
-/// Whether the segment [p, q] (in the body frame) meets the rectangle
-/// [x0, x1] x [-hw, hw] (Liang-Barsky clipping).
-inline bool SegmentMeetsRectangle(const Eigen::Vector2d& p, const Eigen::Vector2d& q, double x0,
-                                  double x1, double hw) {
-  double t0 = 0.0;
-  double t1 = 1.0;
-  const Eigen::Vector2d d = q - p;
-  const double ps[4] = {-d.x(), d.x(), -d.y(), d.y()};
-  const double qs[4] = {p.x() - x0, x1 - p.x(), p.y() + hw, hw - p.y()};
-  for (int k = 0; k < 4; ++k) {
-    if (std::abs(ps[k]) < 1e-15) {
-      if (qs[k] < 0.0) return false;
-      continue;
-    }
-    const double t = qs[k] / ps[k];
-    if (ps[k] < 0.0) {
-      t0 = std::max(t0, t);
-    } else {
-      t1 = std::min(t1, t);
-    }
-    if (t0 > t1) return false;
-  }
-  return true;
-}
+namespace mjslam::testing {
 
 /// The robot and its laser in a world of walls.
 class KinematicSim {
@@ -146,9 +101,4 @@ class KinematicSim {
   double distance_m_ = 0.0;
 };
 
-/// Walls of an axis-aligned rectangle [x0, x1] x [y0, y1].
-inline std::vector<Wall> Box(double x0, double y0, double x1, double y1) {
-  return {{{x0, y0}, {x1, y0}}, {{x1, y0}, {x1, y1}}, {{x1, y1}, {x0, y1}}, {{x0, y1}, {x0, y0}}};
-}
-
-}  // namespace mjslam::explorer::testing
+}  // namespace mjslam::testing
