@@ -96,9 +96,138 @@ bool IsSweepDirectory(const std::string& dir) {
 
 void RenderSweep(const std::string& sweep_dir) { RunReportScript({"sweep", sweep_dir}); }
 
-// Over 80 lines: one frame loop whose state (the frame, the next row) the
-// video and the final image share through two lambdas; to be cut into named
-// steps with the scene split (issue 11, item 2), which rewrites its start.
+namespace {
+
+// A run's recorded files played back as frames: the trajectory, scans and
+// explorer sets up to a time T become the paths, poses, current scan and
+// explorer layers of `frame()`. Time only moves forward.
+class RunPlayback {
+ public:
+  RunPlayback(const fs::path& dir, const RunConfig& config, double min_step_m)
+      : dir_(dir),
+        config_(config),
+        min_step_m_(min_step_m),
+        trajectory_(ReadCsv((dir / rundir::kTrajectoryFile).string())),
+        scans_(ReadCsv((dir / rundir::kScansFile).string())),
+        explorer_(ReadExplorer((dir / rundir::kExplorerFile).string())) {
+    if (trajectory_.rows.empty()) throw std::runtime_error(trajectory_.path + ": no rows to render");
+    t_ = trajectory_.ColumnIndex("t");
+    true_x_ = trajectory_.ColumnIndex("true_x");
+    true_y_ = trajectory_.ColumnIndex("true_y");
+    true_th_ = trajectory_.ColumnIndex("true_th");
+    frame_.filters = FilterLayers();
+    for (const renders::FilterLayer& layer : frame_.filters) {
+      const std::string& name = layer.name;
+      filters_.push_back({trajectory_.ColumnIndex(name + "_x"), trajectory_.ColumnIndex(name + "_y"),
+                          trajectory_.ColumnIndex(name + "_th"), trajectory_.ColumnIndex(name + "_pxx"),
+                          trajectory_.ColumnIndex(name + "_pxy"), trajectory_.ColumnIndex(name + "_pyy")});
+    }
+    scan_t_ = scans_.ColumnIndex("t");
+    scan_x_ = scans_.ColumnIndex("x");
+    scan_y_ = scans_.ColumnIndex("y");
+    scan_th_ = scans_.ColumnIndex("th");
+    scan_r0_ = scans_.ColumnIndex("r0");
+  }
+
+  /// Time of the last row, seconds.
+  double end_t() const { return trajectory_.rows.back()[t_]; }
+  renders::SceneFrame& frame() { return frame_; }
+
+  /// Advances the frame to time T: paths, poses, current scan and explorer sets.
+  void AdvanceTo(double T) {
+    AddRowsUpTo(T);
+    SetScanAt(T);
+    frame_.explorer.reset();
+    const auto snapshot = std::upper_bound(explorer_.begin(), explorer_.end(), T + 1e-9,
+                                           [](double value, const ExplorerSnapshot& s) { return value < s.t_s; });
+    if (snapshot != explorer_.begin()) frame_.explorer = (snapshot - 1)->layer;
+  }
+
+  /// Puts both filters' final maps (map_*.csv) into the frame.
+  void ShowFinalMaps() {
+    for (renders::FilterLayer& layer : frame_.filters) {
+      ReadMap((dir_ / rundir::MapFile(layer.name)).string(), &layer);
+    }
+  }
+
+ private:
+  // The trajectory rows up to T: the paths grow, the poses move.
+  void AddRowsUpTo(double T) {
+    while (next_row_ < trajectory_.rows.size() && trajectory_.rows[next_row_][t_] <= T + 1e-9) {
+      const std::vector<double>& row = trajectory_.rows[next_row_];
+      const bool last = next_row_ + 1 == trajectory_.rows.size();
+      frame_.t_s = row[t_];
+      frame_.X_WR_true = Pose2(row[true_x_], row[true_y_], row[true_th_]);
+      AppendPathPoint(&frame_.true_path, {row[true_x_], row[true_y_]}, min_step_m_, last);
+      for (std::size_t i = 0; i < filters_.size(); ++i) {
+        const FilterColumns& f = filters_[i];
+        renders::FilterLayer& layer = frame_.filters[i];
+        AppendPathPoint(&layer.path, {row[f.x], row[f.y]}, min_step_m_, last);
+        layer.X_WR = Pose2(row[f.x], row[f.y], row[f.th]);
+        layer.P_xy << row[f.pxx], row[f.pxy], row[f.pxy], row[f.pyy];
+      }
+      ++next_row_;
+    }
+  }
+
+  // The hits of the latest scan at or before T (none before the first).
+  void SetScanAt(double T) {
+    const auto scan = std::upper_bound(scans_.rows.begin(), scans_.rows.end(), T + 1e-9,
+                                       [&](double value, const std::vector<double>& row) { return value < row[scan_t_]; });
+    if (scan == scans_.rows.begin()) {
+      frame_.laser_hits.clear();
+      return;
+    }
+    const std::vector<double>& row = *(scan - 1);
+    frame_.laser_hits = LaserHits(Pose2(row[scan_x_], row[scan_y_], row[scan_th_]),
+                                  std::vector<double>(row.begin() + scan_r0_, row.end()),
+                                  config_.laser.max_range_m, config_.laser.AngleMinRad(),
+                                  config_.laser.AngleIncrementRad());
+  }
+
+  fs::path dir_;
+  const RunConfig& config_;
+  double min_step_m_;
+  CsvTable trajectory_;
+  CsvTable scans_;
+  std::vector<ExplorerSnapshot> explorer_;
+  renders::SceneFrame frame_;
+  std::vector<FilterColumns> filters_;
+  int t_ = 0, true_x_ = 0, true_y_ = 0, true_th_ = 0;
+  int scan_t_ = 0, scan_x_ = 0, scan_y_ = 0, scan_th_ = 0, scan_r0_ = 0;
+  std::size_t next_row_ = 0;
+};
+
+// video.mp4: one frame per params.speedup / params.fps simulated seconds,
+// the final maps in the last frame. Fills the video fields of `result`.
+void RenderVideo(const fs::path& dir, const renders::RenderParams& params,
+                 const RenderOptions& options, renders::SceneRenderer* renderer,
+                 RunPlayback* playback, RenderResult* result) {
+  const auto start = std::chrono::steady_clock::now();
+  const double end_t = playback->end_t();
+  const double frame_dt = params.speedup / params.fps;
+  const int num_frames = static_cast<int>(std::floor(end_t / frame_dt + 1e-9)) + 1;
+  renders::VideoWriter video((dir / rundir::kVideoFile).string(), params.width, params.height, params.fps, params.crf);
+  Progress progress("render", num_frames);
+  for (int k = 0; k < num_frames; ++k) {
+    if (options.stop_requested != nullptr && *options.stop_requested != 0) {
+      throw std::runtime_error("render of '" + dir.string() + "' interrupted; no video written");
+    }
+    const bool last = k + 1 == num_frames;
+    playback->AdvanceTo(last ? end_t : k * frame_dt);
+    if (last) playback->ShowFinalMaps();
+    video.AddFrame(renderer->Render(playback->frame()));
+    if (options.show_progress) progress.Update(k + 1);
+  }
+  video.Finish();
+  if (options.show_progress) progress.Finish();
+  result->video_frames = num_frames;
+  result->video_wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  result->video_fps = num_frames / std::max(result->video_wall_s, 1e-9);
+}
+
+}  // namespace
+
 RenderResult RenderRun(const std::string& run_dir, const renders::RenderParams& params,
                        const RenderOptions& options) {
   params.ValidateOrThrow();
@@ -106,103 +235,18 @@ RenderResult RenderRun(const std::string& run_dir, const renders::RenderParams& 
   if (!fs::is_directory(dir)) throw std::runtime_error("run directory not found: '" + run_dir + "'");
   const RunConfig config = LoadRunConfig((dir / rundir::kConfigFile).string(), {});
 
-  // The run's files.
-  const CsvTable trajectory = ReadCsv((dir / rundir::kTrajectoryFile).string());
-  if (trajectory.rows.empty()) throw std::runtime_error(trajectory.path + ": no rows to render");
-  const CsvTable scans = ReadCsv((dir / rundir::kScansFile).string());
-  const std::vector<ExplorerSnapshot> explorer = ReadExplorer((dir / rundir::kExplorerFile).string());
-  const int t_col = trajectory.ColumnIndex("t");
-  const int true_x = trajectory.ColumnIndex("true_x"), true_y = trajectory.ColumnIndex("true_y");
-  const int true_th = trajectory.ColumnIndex("true_th");
-  renders::SceneFrame frame;
-  frame.filters = FilterLayers();
-  std::vector<FilterColumns> filters;
-  for (const renders::FilterLayer& layer : frame.filters) {
-    const std::string& name = layer.name;
-    filters.push_back({trajectory.ColumnIndex(name + "_x"), trajectory.ColumnIndex(name + "_y"),
-                       trajectory.ColumnIndex(name + "_th"), trajectory.ColumnIndex(name + "_pxx"),
-                       trajectory.ColumnIndex(name + "_pxy"), trajectory.ColumnIndex(name + "_pyy")});
-  }
-  const int scan_t = scans.ColumnIndex("t"), scan_x = scans.ColumnIndex("x");
-  const int scan_y = scans.ColumnIndex("y"), scan_th = scans.ColumnIndex("th");
-  const int scan_r0 = scans.ColumnIndex("r0");
-
   renders::SceneRenderer renderer(sim::Scene(config.run.world, config.run.robot_model), config.sim,
                                   config.robot, params.width, params.height);
-  const double min_step_m = PixelSizeM(renderer);
-  frame.ellipse_scale = params.ellipse_scale;
-  std::size_t next_row = 0;
-  auto append = [&](std::vector<Eigen::Vector2d>* path, const Eigen::Vector2d& p, bool last) {
-    AppendPathPoint(path, p, min_step_m, last);
-  };
-  // Advances the frame to time T: paths, poses, current scan and explorer sets.
-  auto advance_to = [&](double T) {
-    while (next_row < trajectory.rows.size() && trajectory.rows[next_row][t_col] <= T + 1e-9) {
-      const std::vector<double>& row = trajectory.rows[next_row];
-      const bool last = next_row + 1 == trajectory.rows.size();
-      frame.t_s = row[t_col];
-      frame.X_WR_true = Pose2(row[true_x], row[true_y], row[true_th]);
-      append(&frame.true_path, {row[true_x], row[true_y]}, last);
-      for (std::size_t i = 0; i < filters.size(); ++i) {
-        const FilterColumns& f = filters[i];
-        renders::FilterLayer& layer = frame.filters[i];
-        append(&layer.path, {row[f.x], row[f.y]}, last);
-        layer.X_WR = Pose2(row[f.x], row[f.y], row[f.th]);
-        layer.P_xy << row[f.pxx], row[f.pxy], row[f.pxy], row[f.pyy];
-      }
-      ++next_row;
-    }
-    const auto scan = std::upper_bound(scans.rows.begin(), scans.rows.end(), T + 1e-9,
-                                       [&](double value, const std::vector<double>& row) { return value < row[scan_t]; });
-    if (scan != scans.rows.begin()) {
-      const std::vector<double>& row = *(scan - 1);
-      frame.laser_hits = LaserHits(Pose2(row[scan_x], row[scan_y], row[scan_th]),
-                                   std::vector<double>(row.begin() + scan_r0, row.end()),
-                                   config.laser.max_range_m, config.laser.AngleMinRad(),
-                                   config.laser.AngleIncrementRad());
-    } else {
-      frame.laser_hits.clear();
-    }
-    frame.explorer.reset();
-    const auto snapshot = std::upper_bound(explorer.begin(), explorer.end(), T + 1e-9,
-                                           [](double value, const ExplorerSnapshot& s) { return value < s.t_s; });
-    if (snapshot != explorer.begin()) frame.explorer = (snapshot - 1)->layer;
-  };
-  auto stopped = [&]() { return options.stop_requested != nullptr && *options.stop_requested != 0; };
+  RunPlayback playback(dir, config, PixelSizeM(renderer));
+  playback.frame().ellipse_scale = params.ellipse_scale;
 
   RenderResult result;
-  const double end_t = trajectory.rows.back()[t_col];
-  if (params.video) {
-    const auto start = std::chrono::steady_clock::now();
-    const double frame_dt = params.speedup / params.fps;
-    const int num_frames = static_cast<int>(std::floor(end_t / frame_dt + 1e-9)) + 1;
-    renders::VideoWriter video((dir / rundir::kVideoFile).string(), params.width, params.height, params.fps, params.crf);
-    Progress progress("render", num_frames);
-    for (int k = 0; k < num_frames; ++k) {
-      if (stopped()) throw std::runtime_error("render of '" + run_dir + "' interrupted; no video written");
-      const bool last = k + 1 == num_frames;
-      advance_to(last ? end_t : k * frame_dt);
-      if (last) {
-        for (std::size_t i = 0; i < filters.size(); ++i) {
-          ReadMap((dir / rundir::MapFile(frame.filters[i].name)).string(), &frame.filters[i]);
-        }
-      }
-      video.AddFrame(renderer.Render(frame));
-      if (options.show_progress) progress.Update(k + 1);
-    }
-    video.Finish();
-    if (options.show_progress) progress.Finish();
-    result.video_frames = num_frames;
-    result.video_wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    result.video_fps = num_frames / std::max(result.video_wall_s, 1e-9);
-  }
+  if (params.video) RenderVideo(dir, params, options, &renderer, &playback, &result);
 
   // The final image: the whole run with both final maps.
-  advance_to(end_t);
-  for (renders::FilterLayer& layer : frame.filters) {
-    ReadMap((dir / rundir::MapFile(layer.name)).string(), &layer);
-  }
-  renders::WritePng((dir / rundir::kFinalImageFile).string(), renderer.Render(frame));
+  playback.AdvanceTo(playback.end_t());
+  playback.ShowFinalMaps();
+  renders::WritePng((dir / rundir::kFinalImageFile).string(), renderer.Render(playback.frame()));
 
   if (params.plots) RunReportScript({"run", dir.string()});
   return result;
