@@ -10,14 +10,14 @@
 
 namespace mjslam::rundir {
 
-eval::Map ReadMapCsv(const std::string& path) {
+FeatureMap ReadMapCsv(const std::string& path) {
   const CsvTable table = ReadCsv(path, {"type"});
   const int id = table.ColumnIndex("id");
   table.ColumnIndex("type");  // throws when missing
   const int p0 = table.ColumnIndex("p0");
   const int c00 = table.ColumnIndex("c00");
   const int ax = table.ColumnIndex("ax");
-  eval::Map map;
+  FeatureMap map;
   for (std::size_t r = 0; r < table.rows.size(); ++r) {
     const std::vector<double>& row = table.rows[r];
     const std::string& kind = table.text[r][0];  // the only text column
@@ -48,7 +48,7 @@ eval::Map ReadMapCsv(const std::string& path) {
   return map;
 }
 
-void WriteMapCsv(const std::string& path, const eval::Map& map) {
+void WriteMapCsv(const std::string& path, const FeatureMap& map) {
   std::string text = HeaderLine(MapColumns());
   for (const MapFeature& f : map) {
     const bool line = f.type == MapFeature::Type::kLine;

@@ -3,7 +3,7 @@
 #include <string>
 #include <vector>
 
-#include "eval/map_types.h"
+#include "common/map_feature.h"
 
 namespace mjslam::rundir {
 
@@ -13,10 +13,10 @@ namespace mjslam::rundir {
 
 /// Reads a map CSV. Throws std::runtime_error naming the file, line and
 /// value for an unknown type or a missing field.
-eval::Map ReadMapCsv(const std::string& path);
+FeatureMap ReadMapCsv(const std::string& path);
 
 /// Writes a map CSV, atomically. Corner kinds are not written (the columns
 /// have no place for them).
-void WriteMapCsv(const std::string& path, const eval::Map& map);
+void WriteMapCsv(const std::string& path, const FeatureMap& map);
 
 }  // namespace mjslam::rundir

@@ -34,7 +34,7 @@ Rule RuleFor(const std::string& folder) {
   if (folder == "eval") return {{"common", "eval"}, false, false, false, false};
   // The run directory's format: common and files. eval/map_types.h is the
   // map feature the map CSVs hold, until one map feature lives in common/.
-  if (folder == "rundir") return {{"common", "rundir", "eval"}, false, false, false, true};
+  if (folder == "rundir") return {{"common", "rundir"}, false, false, false, true};
   if (folder == "config") return {{"common", "config"}, false, true, false, true};
   if (folder == "sim") return {{"common", "sim"}, true, false, false, true};
   if (folder == "renders") return {kCodeFolders, true, false, true, true};

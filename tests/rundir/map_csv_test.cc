@@ -27,7 +27,7 @@ TEST(MapCsvTest, MapRoundTripsBitForBit) {
   const std::string path =
       (std::filesystem::temp_directory_path() / "mjslam_map_csv_test.csv").string();
   WriteMapCsv(path, {line, corner});
-  const eval::Map map = ReadMapCsv(path);
+  const FeatureMap map = ReadMapCsv(path);
   ASSERT_EQ(map.size(), 2u);
   EXPECT_EQ(map[0].id, 3);
   EXPECT_EQ(map[0].type, MapFeature::Type::kLine);
