@@ -11,6 +11,7 @@
 #include "app/sweep.h"
 #include "eval/chi_square.h"
 #include "rundir/csv_reader.h"
+#include "rundir/layout.h"
 
 namespace mjslam::app {
 namespace {
@@ -33,7 +34,7 @@ std::string FreshDir(const std::string& name) {
 void WriteRun(const std::string& dir, const std::vector<double>& classical_nees,
               const std::vector<double>& selective_nees, bool with_period) {
   fs::create_directories(dir);
-  std::ofstream out(dir + "/trajectory.csv");
+  std::ofstream out(rundir::PathIn(dir, rundir::kTrajectoryFile));
   out << "t,classical_us,classical_nees,selective_us,selective_nees";
   if (with_period) {
     out << ",classical_period,selective_period,classical_open_loop,selective_open_loop";

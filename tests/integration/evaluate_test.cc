@@ -13,6 +13,7 @@
 #include "app/sweep.h"
 #include "rundir/map_csv.h"
 #include "tests/integration/run_helpers.h"
+#include "rundir/layout.h"
 
 namespace mjslam::testing {
 namespace {
@@ -39,14 +40,14 @@ TEST(EvaluateTest, WritesGroundTruthAndMergesMetricsIntoSummary) {
   const std::string dir = FreshDir("evaluate") + "/run";
   RunRoom(dir, 3);
   // Another writer's key, to be kept.
-  WriteText(dir + "/summary.json", R"({"run": {"duration_s": 10}, "filters": {"classical": {"processing_s": 1.5}}})");
+  WriteText(rundir::PathIn(dir, rundir::kSummaryFile), R"({"run": {"duration_s": 10}, "filters": {"classical": {"processing_s": 1.5}}})");
   ASSERT_EQ(Shell(Program() + " evaluate " + dir + " --divergence-points 2000 > " + dir +
                   ".eval.log 2>&1"),
             0)
       << ReadText(dir + ".eval.log");
 
   // The room seen from inside: 4 lines (rho 3 or 4) and 4 corners.
-  const eval::Map truth = rundir::ReadMapCsv(dir + "/ground_truth_map.csv");
+  const eval::Map truth = rundir::ReadMapCsv(rundir::PathIn(dir, rundir::kGroundTruthMapFile));
   ASSERT_EQ(truth.size(), 8u);
   for (const MapFeature& f : truth) {
     if (f.type == MapFeature::Type::kLine) {
@@ -57,11 +58,11 @@ TEST(EvaluateTest, WritesGroundTruthAndMergesMetricsIntoSummary) {
       EXPECT_NEAR(std::abs(f.params.y()), 3.0, 1e-9);
     }
   }
-  const rundir::CsvTable table = rundir::ReadCsv(dir + "/ground_truth_map.csv", {"type"});
+  const rundir::CsvTable table = rundir::ReadCsv(rundir::PathIn(dir, rundir::kGroundTruthMapFile), {"type"});
   EXPECT_EQ(table.columns, (std::vector<std::string>{"id", "type", "p0", "p1", "c00", "c01", "c11",
                                                       "ax", "ay", "bx", "by"}));
 
-  const nlohmann::json summary = nlohmann::json::parse(ReadText(dir + "/summary.json"));
+  const nlohmann::json summary = nlohmann::json::parse(ReadText(rundir::PathIn(dir, rundir::kSummaryFile)));
   EXPECT_EQ(summary["run"]["duration_s"], 10);
   EXPECT_EQ(summary["filters"]["classical"]["processing_s"], 1.5);
   for (const std::string f : {"classical", "selective"}) {
@@ -84,22 +85,22 @@ TEST(EvaluateTest, WritesGroundTruthAndMergesMetricsIntoSummary) {
 TEST(EvaluateTest, BadInputsNameTheFileAndWriteNothing) {
   const std::string dir = FreshDir("evaluate_bad") + "/run";
   RunRoom(dir, 1);
-  WriteText(dir + "/summary.json", "[1, 2]");
+  WriteText(rundir::PathIn(dir, rundir::kSummaryFile), "[1, 2]");
   EXPECT_EQ(Shell(Program() + " evaluate " + dir + " > " + dir + ".log 2>&1"), 1);
   EXPECT_NE(ReadText(dir + ".log").find("summary.json: expected a JSON object"),
             std::string::npos)
       << ReadText(dir + ".log");
-  EXPECT_EQ(ReadText(dir + "/summary.json"), "[1, 2]");
-  fs::remove(dir + "/summary.json");
+  EXPECT_EQ(ReadText(rundir::PathIn(dir, rundir::kSummaryFile)), "[1, 2]");
+  fs::remove(rundir::PathIn(dir, rundir::kSummaryFile));
   // A map with an unknown feature type.
-  std::string map = ReadText(dir + "/map_selective.csv");
+  std::string map = ReadText(rundir::PathIn(dir, rundir::MapFile("selective")));
   map.replace(map.find(",line,"), 6, ",wall,");
-  WriteText(dir + "/map_selective.csv", map);
+  WriteText(rundir::PathIn(dir, rundir::MapFile("selective")), map);
   EXPECT_EQ(Shell(Program() + " evaluate " + dir + " > " + dir + ".log 2>&1"), 1);
   EXPECT_NE(ReadText(dir + ".log").find("map_selective.csv:2: type: expected line or corner (got 'wall')"),
             std::string::npos)
       << ReadText(dir + ".log");
-  EXPECT_FALSE(fs::exists(dir + "/summary.json"));
+  EXPECT_FALSE(fs::exists(rundir::PathIn(dir, rundir::kSummaryFile)));
   EXPECT_EQ(Shell(Program() + " evaluate " + dir + "/nowhere > " + dir + ".log 2>&1"), 1);
   EXPECT_NE(ReadText(dir + ".log").find("nowhere/manifest.json: missing"), std::string::npos)
       << ReadText(dir + ".log");
@@ -160,8 +161,8 @@ TEST_F(SweepTest, RunsAreBitIdenticalToSingleRunsAndTheAggregateIsWritten) {
   for (const char* file : {"config.yaml", "scans.csv", "map_classical.csv", "map_selective.csv"}) {
     EXPECT_EQ(ReadText(run + "/" + file), ReadText(single + "/" + file)) << file;
   }
-  const rundir::CsvTable a = DropColumns(rundir::ReadCsv(run + "/trajectory.csv"), "_us");
-  const rundir::CsvTable b = DropColumns(rundir::ReadCsv(single + "/trajectory.csv"), "_us");
+  const rundir::CsvTable a = DropColumns(rundir::ReadCsv(rundir::PathIn(run, rundir::kTrajectoryFile)), "_us");
+  const rundir::CsvTable b = DropColumns(rundir::ReadCsv(rundir::PathIn(single, rundir::kTrajectoryFile)), "_us");
   EXPECT_EQ(a.columns, b.columns);
   // Bit for bit; empty cells (NaN, e.g. f_nees at the known start) must be
   // empty in both.
@@ -185,7 +186,7 @@ TEST_F(SweepTest, RunsAreBitIdenticalToSingleRunsAndTheAggregateIsWritten) {
   EXPECT_LE(nees.rows.size(), 60u);
   EXPECT_EQ(nees.rows[0][5], 3.0);
   EXPECT_NEAR(nees.rows[0][3], 2.7004 / 3.0, 1e-3);  // chi2_9(0.025) / 3
-  const nlohmann::json summary = nlohmann::json::parse(ReadText(dir + "/summary.json"));
+  const nlohmann::json summary = nlohmann::json::parse(ReadText(rundir::PathIn(dir, rundir::kSummaryFile)));
   EXPECT_EQ(summary["sweep"]["completed_runs"], 3);
   EXPECT_TRUE(summary["filters"]["selective"]["processing_s"].get<double>() > 0.0);
   EXPECT_GE(summary["filters"]["selective"]["open_loop_s"].get<double>(), 0.0);

@@ -12,6 +12,7 @@
 #include "sim/obstacles.h"
 #include "sim/scene.h"
 #include "tests/integration/run_helpers.h"
+#include "rundir/layout.h"
 
 namespace mjslam::testing {
 namespace {
@@ -26,7 +27,7 @@ TEST_P(GroundTruthWorldTest, EveryEchoLiesOnATrueSegmentOrAPillar) {
             0)
       << ReadText(dir + ".log");
   const eval::Map truth = app::RunGroundTruth(dir);
-  const app::RunConfig config = app::LoadRunConfig(dir + "/config.yaml", {});
+  const app::RunConfig config = app::LoadRunConfig(rundir::PathIn(dir, rundir::kConfigFile), {});
   const sim::Scene scene(config.run.world, config.run.robot_model);
   std::vector<sim::ObstacleFootprint> pillars;
   for (const sim::ObstacleFootprint& o : scene.Obstacles()) {
@@ -55,7 +56,7 @@ TEST_P(GroundTruthWorldTest, EveryEchoLiesOnATrueSegmentOrAPillar) {
 
   // Echoes: the scan's ranges from the true laser pose. 5 mm range noise,
   // so within 3 cm of a true segment (or a pillar) for every echo.
-  const rundir::CsvTable scans = rundir::ReadCsv(dir + "/scans.csv");
+  const rundir::CsvTable scans = rundir::ReadCsv(rundir::PathIn(dir, rundir::kScansFile));
   const double max_range = config.laser.max_range_m;
   int echoes = 0;
   int off = 0;

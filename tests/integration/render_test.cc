@@ -12,6 +12,7 @@
 #include "rundir/csv_reader.h"
 #include "renders/image.h"
 #include "tests/integration/run_helpers.h"
+#include "rundir/layout.h"
 
 namespace mjslam::testing {
 namespace {
@@ -78,7 +79,7 @@ TEST(RenderTest, RunAndRenderLeaveImageVideoPlotsAndAPageThatLoads) {
     fs::remove(older + "/" + name);
   }
   {
-    const rundir::CsvTable table = rundir::ReadCsv(dir + "/trajectory.csv");
+    const rundir::CsvTable table = rundir::ReadCsv(rundir::PathIn(dir, rundir::kTrajectoryFile));
     std::vector<std::size_t> kept;
     for (std::size_t c = 0; c < table.columns.size(); ++c) {
       const std::string& name = table.columns[c];
@@ -87,8 +88,8 @@ TEST(RenderTest, RunAndRenderLeaveImageVideoPlotsAndAPageThatLoads) {
                             name.find("_nees") != std::string::npos;
       if (!optional) kept.push_back(c);
     }
-    std::ifstream in(dir + "/trajectory.csv");
-    std::ofstream out(older + "/trajectory.csv");
+    std::ifstream in(rundir::PathIn(dir, rundir::kTrajectoryFile));
+    std::ofstream out(rundir::PathIn(older, rundir::kTrajectoryFile));
     std::string line;
     while (std::getline(in, line)) {
       std::vector<std::string> cells;
@@ -124,7 +125,7 @@ TEST(RenderCommandTest, SweepDirectoryGetsPlotsAndPage) {
   std::ofstream(dir + "/divergence.csv") << "num_points,pair,mean,variance\n"
                                             "10,classical_selective,0.5,0.2\n100,classical_selective,0.4,0.05\n"
                                             "10,selective_truth,0.8,0.3\n100,selective_truth,0.7,0.1\n";
-  std::ofstream(dir + "/summary.json") << R"({"runs": 1})";
+  std::ofstream(rundir::PathIn(dir, rundir::kSummaryFile)) << R"({"runs": 1})";
   ASSERT_EQ(Shell(Program() + " render " + dir + " 2> " + dir + ".log"), 0) << ReadText(dir + ".log");
   EXPECT_TRUE(fs::exists(dir + "/plot_nees.png"));
   EXPECT_TRUE(fs::exists(dir + "/plot_divergence.png"));
@@ -133,9 +134,9 @@ TEST(RenderCommandTest, SweepDirectoryGetsPlotsAndPage) {
 
 TEST(RenderCommandTest, MissingRunFileIsAnErrorNamingIt) {
   const std::string dir = FreshDir("not_a_run");
-  std::ofstream(dir + "/manifest.json") << "{}";
+  std::ofstream(rundir::PathIn(dir, rundir::kManifestFile)) << "{}";
   EXPECT_EQ(Shell(Program() + " render --quiet " + dir + " 2> " + dir + ".log"), 1);
-  EXPECT_NE(ReadText(dir + ".log").find(dir + "/config.yaml"), std::string::npos) << ReadText(dir + ".log");
+  EXPECT_NE(ReadText(dir + ".log").find(rundir::PathIn(dir, rundir::kConfigFile)), std::string::npos) << ReadText(dir + ".log");
   EXPECT_FALSE(fs::exists(dir + "/final.png"));
   EXPECT_FALSE(fs::exists(dir + "/index.html"));
 }

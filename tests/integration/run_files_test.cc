@@ -59,16 +59,16 @@ std::string* RunFilesTest::second_ = nullptr;
 TEST_F(RunFilesTest, WritesEveryFileWithTheDocumentedColumns) {
   // Exactly the columns of rundir/layout.h (which tests/rundir/layout_test.cc
   // checks against docs/run_directory.md).
-  const CsvTable trajectory = ReadCsv(*first_ + "/trajectory.csv");
+  const CsvTable trajectory = ReadCsv(rundir::PathIn(*first_, rundir::kTrajectoryFile));
   EXPECT_EQ(trajectory.columns, rundir::TrajectoryColumns());
   EXPECT_EQ(trajectory.columns[9], "explored");
   EXPECT_EQ(trajectory.columns.back(), "selective_nees");
-  EXPECT_EQ(ReadCsv(*first_ + "/explorer.csv", {"kind"}).columns, rundir::ExplorerColumns());
+  EXPECT_EQ(ReadCsv(rundir::PathIn(*first_, rundir::kExplorerFile), {"kind"}).columns, rundir::ExplorerColumns());
   // 12 s at 10 Hz: steps at t = 0, 0.1, ..., 12.
   ASSERT_EQ(trajectory.rows.size(), 121u);
   EXPECT_NEAR(trajectory.rows.back()[0], 12.0, 1e-9);
 
-  const CsvTable scans = ReadCsv(*first_ + "/scans.csv");
+  const CsvTable scans = ReadCsv(rundir::PathIn(*first_, rundir::kScansFile));
   ASSERT_EQ(scans.columns, rundir::ScanColumns(181));
   EXPECT_EQ(scans.columns[4], "r0");
   EXPECT_EQ(scans.columns.back(), "r180");
@@ -85,13 +85,13 @@ TEST_F(RunFilesTest, WritesEveryFileWithTheDocumentedColumns) {
     EXPECT_EQ(text.substr(0, text.find('\n')), "id,type,p0,p1,c00,c01,c11,ax,ay,bx,by");
     EXPECT_EQ(text.substr(0, text.find('\n') + 1), rundir::HeaderLine(rundir::MapColumns()));
   }
-  const nlohmann::json manifest = nlohmann::json::parse(ReadText(*first_ + "/manifest.json"));
+  const nlohmann::json manifest = nlohmann::json::parse(ReadText(rundir::PathIn(*first_, rundir::kManifestFile)));
   EXPECT_EQ(manifest["status"], "completed");
   EXPECT_EQ(manifest["seed"], 5);
   EXPECT_EQ(manifest["mujoco_version"], "2.2.2");
   EXPECT_EQ(manifest["world_hash"].get<std::string>().substr(0, 8), "fnv1a64:");
   EXPECT_FALSE(manifest["end_time"].is_null());
-  EXPECT_NE(ReadText(*first_ + "/config.yaml").find("seed: 5"), std::string::npos);
+  EXPECT_NE(ReadText(rundir::PathIn(*first_, rundir::kConfigFile)).find("seed: 5"), std::string::npos);
 }
 
 TEST_F(RunFilesTest, SameSeedGivesIdenticalFiles) {
@@ -100,10 +100,10 @@ TEST_F(RunFilesTest, SameSeedGivesIdenticalFiles) {
     EXPECT_EQ(ReadText(*first_ + "/" + file), ReadText(*second_ + "/" + file)) << file;
   }
   // Trajectories agree bit for bit except the measured processing times.
-  ExpectSameTable(DropColumns(ReadCsv(*first_ + "/trajectory.csv"), "_us"),
-                  DropColumns(ReadCsv(*second_ + "/trajectory.csv"), "_us"));
-  nlohmann::json a = nlohmann::json::parse(ReadText(*first_ + "/manifest.json"));
-  nlohmann::json b = nlohmann::json::parse(ReadText(*second_ + "/manifest.json"));
+  ExpectSameTable(DropColumns(ReadCsv(rundir::PathIn(*first_, rundir::kTrajectoryFile)), "_us"),
+                  DropColumns(ReadCsv(rundir::PathIn(*second_, rundir::kTrajectoryFile)), "_us"));
+  nlohmann::json a = nlohmann::json::parse(ReadText(rundir::PathIn(*first_, rundir::kManifestFile)));
+  nlohmann::json b = nlohmann::json::parse(ReadText(rundir::PathIn(*second_, rundir::kManifestFile)));
   for (const char* key : {"start_time", "end_time", "command_line"}) {
     a.erase(key);
     b.erase(key);
@@ -114,7 +114,7 @@ TEST_F(RunFilesTest, SameSeedGivesIdenticalFiles) {
 TEST_F(RunFilesTest, AnotherSeedGivesOtherNoise) {
   const std::string dir = FreshDir("other_seed");
   ASSERT_EQ(ShortRun(dir, 6), 0) << ReadText(dir + ".log");
-  EXPECT_NE(ReadText(*first_ + "/scans.csv"), ReadText(dir + "/scans.csv"));
+  EXPECT_NE(ReadText(rundir::PathIn(*first_, rundir::kScansFile)), ReadText(rundir::PathIn(dir, rundir::kScansFile)));
 }
 
 TEST_F(RunFilesTest, ReplayReproducesTheFilters) {
@@ -123,10 +123,10 @@ TEST_F(RunFilesTest, ReplayReproducesTheFilters) {
                   *first_ + "/config.yaml --out " + dir + " 2> " + dir + ".log"),
             0)
       << ReadText(dir + ".log");
-  ExpectSameTable(DropColumns(ReadCsv(*first_ + "/trajectory.csv"), "_us"),
-                  DropColumns(ReadCsv(dir + "/trajectory.csv"), "_us"));
-  EXPECT_EQ(ReadText(*first_ + "/map_selective.csv"), ReadText(dir + "/map_selective.csv"));
-  EXPECT_EQ(ReadText(*first_ + "/map_classical.csv"), ReadText(dir + "/map_classical.csv"));
+  ExpectSameTable(DropColumns(ReadCsv(rundir::PathIn(*first_, rundir::kTrajectoryFile)), "_us"),
+                  DropColumns(ReadCsv(rundir::PathIn(dir, rundir::kTrajectoryFile)), "_us"));
+  EXPECT_EQ(ReadText(rundir::PathIn(*first_, rundir::MapFile("selective"))), ReadText(rundir::PathIn(dir, rundir::MapFile("selective"))));
+  EXPECT_EQ(ReadText(rundir::PathIn(*first_, rundir::MapFile("classical"))), ReadText(rundir::PathIn(dir, rundir::MapFile("classical"))));
 }
 
 TEST(RunFailureTest, InterruptedRunKeepsCompleteRowsAndSaysSo) {
@@ -141,7 +141,7 @@ TEST(RunFailureTest, InterruptedRunKeepsCompleteRowsAndSaysSo) {
     _exit(127);
   }
   // Wait until rows have reached the disk, then interrupt.
-  const std::string trajectory = dir + "/trajectory.csv";
+  const std::string trajectory = rundir::PathIn(dir, rundir::kTrajectoryFile);
   for (int i = 0; i < 600; ++i) {
     std::this_thread::sleep_for(std::chrono::milliseconds(100));
     if (std::filesystem::exists(trajectory) && std::filesystem::file_size(trajectory) > 200000) {
@@ -153,12 +153,12 @@ TEST(RunFailureTest, InterruptedRunKeepsCompleteRowsAndSaysSo) {
   waitpid(child, &status, 0);
   ASSERT_TRUE(WIFEXITED(status));
   EXPECT_EQ(WEXITSTATUS(status), 130);
-  const nlohmann::json manifest = nlohmann::json::parse(ReadText(dir + "/manifest.json"));
+  const nlohmann::json manifest = nlohmann::json::parse(ReadText(rundir::PathIn(dir, rundir::kManifestFile)));
   EXPECT_EQ(manifest["status"], "interrupted");
   const CsvTable rows = ReadCsv(trajectory);  // throws on a partial row
   EXPECT_GT(rows.rows.size(), 100u);
   EXPECT_EQ(manifest["steps"].get<std::size_t>(), rows.rows.size());
-  EXPECT_NO_THROW(ReadCsv(dir + "/scans.csv"));
+  EXPECT_NO_THROW(ReadCsv(rundir::PathIn(dir, rundir::kScansFile)));
 }
 
 TEST(RunFailureTest, MissingWorldIsAClearErrorAndNoRunIsStarted) {

@@ -7,6 +7,7 @@
 
 #include "common/angles.h"
 #include "tests/integration/run_helpers.h"
+#include "rundir/layout.h"
 
 namespace mjslam::testing {
 namespace {
@@ -27,7 +28,7 @@ class SlamRunTest : public ::testing::Test {
                 0)
           << ReadText(dir + ".log");
       if (dir_ == nullptr) dir_ = new std::string(dir);  // maps of the first run
-      const rundir::CsvTable run = rundir::ReadCsv(dir + "/trajectory.csv");
+      const rundir::CsvTable run = rundir::ReadCsv(rundir::PathIn(dir, rundir::kTrajectoryFile));
       if (table_ == nullptr) table_ = new rundir::CsvTable(run);
       else table_->rows.insert(table_->rows.end(), run.rows.begin(), run.rows.end());
     }

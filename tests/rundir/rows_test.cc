@@ -35,7 +35,7 @@ std::string ReadText(const std::string& path) {
 }
 
 TEST(RowsTest, TrajectoryRowFillsTheColumnsAndLeavesUndefinedValuesEmpty) {
-  const std::string path = FreshDir("trajectory") + "/trajectory.csv";
+  const std::string path = rundir::PathIn(FreshDir("trajectory"), rundir::kTrajectoryFile);
   {
     CsvWriter writer(path, TrajectoryColumns());
     TrajectoryRow row;
@@ -72,7 +72,7 @@ TEST(RowsTest, TrajectoryRowFillsTheColumnsAndLeavesUndefinedValuesEmpty) {
 }
 
 TEST(RowsTest, ExplorerSnapshotsRoundTrip) {
-  const std::string path = FreshDir("explorer") + "/explorer.csv";
+  const std::string path = rundir::PathIn(FreshDir("explorer"), rundir::kExplorerFile);
   ExplorerSnapshot first;
   first.t_s = 0.0;
   first.frontier = {{1.0, 2.0}, {3.0, 4.0}};
@@ -101,12 +101,12 @@ TEST(RowsTest, ExplorerSnapshotsRoundTrip) {
 TEST(RecordingTest, ReadsStepsScansAndTheMountFromTheFirstScan) {
   const std::string dir = FreshDir("recording");
   // Two steps, a scan at the second; the laser 0.1 m ahead of R.
-  std::ofstream(dir + "/trajectory.csv")
+  std::ofstream(rundir::PathIn(dir, rundir::kTrajectoryFile))
       << "t,true_x,true_y,true_th,odom_x,odom_y,odom_th,cmd_v,cmd_w\n"
          "0,1,2,0,1,2,0,0.2,0\n0.1,1,2,0,1.01,2,0,0.2,0.1\n";
-  std::ofstream(dir + "/scans.csv") << "t,x,y,th,r0,r1\n0.1,1.1,2,0,3,4\n";
-  const Recording recording(dir + "/scans.csv", "", 2);
-  EXPECT_EQ(recording.trajectory_path(), dir + "/trajectory.csv");
+  std::ofstream(rundir::PathIn(dir, rundir::kScansFile)) << "t,x,y,th,r0,r1\n0.1,1.1,2,0,3,4\n";
+  const Recording recording(rundir::PathIn(dir, rundir::kScansFile), "", 2);
+  EXPECT_EQ(recording.trajectory_path(), rundir::PathIn(dir, rundir::kTrajectoryFile));
   ASSERT_EQ(recording.num_steps(), 2u);
   EXPECT_NEAR(recording.X_RS().x, 0.1, 1e-12);
   EXPECT_EQ(recording.Step(0).scan_ranges_m, nullptr);
@@ -118,10 +118,10 @@ TEST(RecordingTest, ReadsStepsScansAndTheMountFromTheFirstScan) {
   EXPECT_TRUE(std::isnan(step.explored));  // the recording has no explored column
 
   // Another beam count, or a trajectory whose columns are out of order.
-  EXPECT_THROW(Recording(dir + "/scans.csv", "", 3), std::runtime_error);
+  EXPECT_THROW(Recording(rundir::PathIn(dir, rundir::kScansFile), "", 3), std::runtime_error);
   std::ofstream(dir + "/other.csv")
       << "t,true_y,true_x,true_th,odom_x,odom_y,odom_th,cmd_v,cmd_w\n0,1,2,0,1,2,0,0,0\n";
-  EXPECT_THROW(Recording(dir + "/scans.csv", dir + "/other.csv", 2), std::runtime_error);
+  EXPECT_THROW(Recording(rundir::PathIn(dir, rundir::kScansFile), dir + "/other.csv", 2), std::runtime_error);
 }
 
 }  // namespace
