@@ -359,7 +359,10 @@ int main(int argc, char** argv) {
       if (command->parsed()) return execute();
     }
   } catch (const std::exception& error) {
-    std::fprintf(stderr, "mjslam: error:\n%s\n", error.what());
+    // One problem on the line of its prefix; several (a config's) below it.
+    const std::string message = error.what();
+    const char* separator = message.find('\n') == std::string::npos ? " " : "\n";
+    std::fprintf(stderr, "mjslam: error:%s%s\n", separator, message.c_str());
     // A render stopped by Ctrl-C or SIGTERM is an interrupt, not a failure.
     if (app::g_stop_requested != 0) return 130;
     return 1;

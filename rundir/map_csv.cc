@@ -9,6 +9,45 @@
 #include "rundir/run_files.h"
 
 namespace mjslam::rundir {
+namespace {
+
+// Coordinates beyond this are no building's (metres): a damaged file, not a map.
+constexpr double kMaxCoordinateM = 1e6;
+
+// The problem with row values of a feature, or "" when they are a map's.
+std::string FeatureProblem(const MapFeature& f) {
+  constexpr double kPi = 3.14159265358979323846;
+  if (!f.params.allFinite() || !f.covariance.allFinite()) return "p0, p1, c00, c01, c11: expected numbers";
+  if (f.type == MapFeature::Type::kLine) {
+    if (!(f.params.x() >= 0.0 && f.params.x() <= kMaxCoordinateM)) {
+      return "p0: expected a line distance rho in [0, 1e6] m";
+    }
+    if (!(std::abs(f.params.y()) <= kPi + 1e-9)) return "p1: expected a line angle alpha in [-pi, pi]";
+  } else if (f.params.cwiseAbs().maxCoeff() > kMaxCoordinateM) {
+    return "p0, p1: expected a corner within 1e6 m of the origin";
+  }
+  // A covariance: symmetric (one c01) and positive semidefinite (the ground
+  // truth's is zero). The determinant may round a little below zero.
+  const double c00 = f.covariance(0, 0), c01 = f.covariance(0, 1), c11 = f.covariance(1, 1);
+  if (!(c00 >= 0.0 && c11 >= 0.0 && c00 * c11 - c01 * c01 >= -1e-9 * c00 * c11) ||
+      c00 > kMaxCoordinateM * kMaxCoordinateM || c11 > kMaxCoordinateM * kMaxCoordinateM) {
+    return "c00, c01, c11: expected a positive semidefinite covariance";
+  }
+  if (f.has_segment && (f.p_WA.cwiseAbs().maxCoeff() > kMaxCoordinateM ||
+                        f.p_WB.cwiseAbs().maxCoeff() > kMaxCoordinateM)) {
+    return "ax, ay, bx, by: expected a segment within 1e6 m of the origin";
+  }
+  return "";
+}
+
+// The row's values as text, for an error message.
+std::string RowValues(const std::vector<double>& row, int first, int count) {
+  std::string text;
+  for (int i = first; i < first + count; ++i) text += (i > first ? ", " : "") + FormatDouble(row[i]);
+  return text;
+}
+
+}  // namespace
 
 FeatureMap ReadMapCsv(const std::string& path) {
   const CsvTable table = ReadCsv(path, {"type"});
@@ -33,15 +72,15 @@ FeatureMap ReadMapCsv(const std::string& path) {
     }
     f.params = {row[p0], row[p0 + 1]};
     f.covariance << row[c00], row[c00 + 1], row[c00 + 1], row[c00 + 2];
-    if (!f.params.allFinite() || !f.covariance.allFinite()) {
-      throw std::runtime_error(where + "p0, p1, c00, c01, c11: expected numbers");
-    }
     f.has_segment = f.type == MapFeature::Type::kLine && std::isfinite(row[ax]) &&
                     std::isfinite(row[ax + 1]) && std::isfinite(row[ax + 2]) &&
                     std::isfinite(row[ax + 3]);
     if (f.has_segment) {
       f.p_WA = {row[ax], row[ax + 1]};
       f.p_WB = {row[ax + 2], row[ax + 3]};
+    }
+    if (const std::string problem = FeatureProblem(f); !problem.empty()) {
+      throw std::runtime_error(where + problem + " (got p0..c11 = " + RowValues(row, p0, 5) + ")");
     }
     map.push_back(f);
   }
