@@ -6,6 +6,11 @@
 #include "config/config.h"
 
 namespace mjslam::app {
+namespace {
+
+constexpr double kMaxControlSteps = 1e8;
+
+}  // namespace
 
 std::vector<ParamProblem> RunParams::Validate() const {
   ParamChecker check;
@@ -28,6 +33,13 @@ std::vector<ParamProblem> RunConfig::Validate() const {
   check.Merge("control", control.Validate());
   check.Merge("explorer", explorer.Validate());
   check.Merge("render", render.Validate());
+  // Control steps are counted in an int: at most 1e8 (about 115 days at
+  // 10 Hz); this also refuses an infinite duration.
+  if (run.duration_s > 0 && run.control_rate_hz > 0) {
+    check.Require(run.duration_s * run.control_rate_hz <= kMaxControlSteps, "run.duration_s",
+                  run.duration_s,
+                  "at most 1e8 control steps (duration_s * control_rate_hz <= 1e8)");
+  }
   // The laser fires on control steps only.
   if (run.control_rate_hz > 0 && laser.rate_hz > 0) {
     const double ratio = run.control_rate_hz / laser.rate_hz;

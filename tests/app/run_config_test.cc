@@ -52,6 +52,23 @@ TEST(RunConfigTest, LaserRateMustDivideControlRate) {
   }
 }
 
+// duration_s * control_rate_hz is a step count held in an int: 1e12 s
+// overflowed to a run of 0 steps that said "completed".
+TEST(RunConfigTest, DurationBeyondOneHundredMillionStepsIsRefused) {
+  const std::string path = std::string(MJSLAM_SOURCE_DIR) + "/configs/default.yaml";
+  EXPECT_NO_THROW(LoadRunConfig(path, {"run.duration_s=1e7"}));  // 1e8 steps at 10 Hz
+  for (const std::string value : {"1e12", "1.0000001e7", ".inf"}) {
+    try {
+      LoadRunConfig(path, {"run.duration_s=" + value});
+      ADD_FAILURE() << "expected an error for " << value;
+    } catch (const std::exception& error) {
+      EXPECT_NE(std::string(error.what()).find("run.duration_s: expected at most 1e8 control steps"),
+                std::string::npos)
+          << error.what();
+    }
+  }
+}
+
 TEST(RunConfigTest, FiltersMustPredictTheRobotsPointH) {
   const std::string path = std::string(MJSLAM_SOURCE_DIR) + "/configs/default.yaml";
   EXPECT_NO_THROW(LoadRunConfig(

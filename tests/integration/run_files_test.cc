@@ -183,5 +183,22 @@ TEST(RunFailureTest, BadOverrideNamesTheKeyAndValue) {
   EXPECT_FALSE(std::filesystem::exists(dir + "/run/trajectory.csv"));
 }
 
+// A negative seed wrapped to 2^64 - 1 and a huge duration overflowed the
+// step count to a "completed" run of no steps; both are refused up front.
+TEST(RunFailureTest, NegativeSeedAndHugeDurationAreRefused) {
+  const std::string dir = FreshDir("bad_numbers");
+  const std::string run = Program() + " run --quiet --no-render --config " + DefaultConfig() +
+                          " --out " + dir + "/run ";
+  EXPECT_NE(Shell(run + "--seed -1 2> " + dir + "/seed.log"), 0);
+  EXPECT_NE(ReadText(dir + "/seed.log").find("--seed: expected a non-negative integer (got -1)"),
+            std::string::npos)
+      << ReadText(dir + "/seed.log");
+  EXPECT_EQ(Shell(run + "--duration 1e12 2> " + dir + "/duration.log"), 1);
+  EXPECT_NE(ReadText(dir + "/duration.log").find("run.duration_s: expected at most 1e8 control steps"),
+            std::string::npos)
+      << ReadText(dir + "/duration.log");
+  EXPECT_FALSE(std::filesystem::exists(dir + "/run/trajectory.csv"));
+}
+
 }  // namespace
 }  // namespace mjslam::testing
