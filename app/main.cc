@@ -35,6 +35,17 @@ std::string JoinArguments(int argc, char** argv) {
   return text;
 }
 
+// Checks an unsigned option's text: CLI11 would wrap -1 to 2^64 - 1.
+CLI::Validator NonNegativeInteger() {
+  return CLI::Validator(
+      [](std::string& text) {
+        return text.find('-') == std::string::npos
+                   ? std::string()
+                   : "expected a non-negative integer (got " + text + ")";
+      },
+      "", "non-negative");
+}
+
 // The options every config-loading subcommand shares.
 struct ConfigOptions {
   std::string path = std::string(MJSLAM_SOURCE_DIR) + "/configs/default.yaml";
@@ -64,15 +75,8 @@ CLI::App* AddRun(CLI::App* cli, RunCommand* c) {
                    "Override any config key, e.g. --set laser.range_noise_std_m=0 (the simulated "
                    "laser; the filters' model is slam.features.range_noise_std_m)");
   run->add_option("--world", c->world, "World MJCF file (overrides run.world)");
-  // A seed of -1 would otherwise wrap to 2^64 - 1 (the YAML key rejects it too).
   run->add_option("--seed", c->seed, "Root random seed (overrides run.seed)")
-      ->check(CLI::Validator(
-          [](std::string& text) {
-            return text.find('-') == std::string::npos
-                       ? std::string()
-                       : "expected a non-negative integer (got " + text + ")";
-          },
-          "", "non-negative"));
+      ->check(NonNegativeInteger());
   run->add_option("--duration", c->duration_s, "Simulated seconds (overrides run.duration_s)");
   run->add_option("--out", c->out_dir, "Run directory [runs/<world>-seed<seed>]");
   run->add_flag("--quiet", c->quiet, "No progress bar");
@@ -219,13 +223,7 @@ CLI::App* AddSweep(CLI::App* cli, SweepCommand* c) {
   sweep->add_option("--runs", c->options.runs, "Number of runs")->required()->check(CLI::PositiveNumber);
   sweep->add_option("--jobs", c->options.jobs, "Runs at a time (0: one per core)")
       ->capture_default_str()
-      ->check(CLI::Validator(
-          [](std::string& text) {
-            return text.find('-') == std::string::npos
-                       ? std::string()
-                       : "expected a non-negative integer (got " + text + ")";
-          },
-          "", "non-negative"));
+      ->check(NonNegativeInteger());
   sweep->add_option("--out", c->options.out_dir, "Sweep directory")->required();
   sweep->add_option("--duration", c->duration_s, "Simulated seconds of each run (overrides run.duration_s)");
   sweep->add_option("--divergence-points", c->options.divergence_points,
