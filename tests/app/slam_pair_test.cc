@@ -185,5 +185,36 @@ TEST(SlamPairTest, RealtimePredictionTakesTheOdometryOfTheSkippedSteps) {
   EXPECT_EQ(realtime.scans_skipped(0), 9);
 }
 
+// On an arc the skid term of the prediction depends on dt: the odometry
+// prediction over skipped steps must use the whole time since the last
+// processed record, as one filter given just those two records would.
+TEST(SlamPairTest, RealtimeOdometryPredictionUsesTheWholeElapsedTime) {
+  std::vector<SensorRecord> records = StraightRecords(std::vector<double>(5, 0.5));
+  for (std::size_t k = 0; k < records.size(); ++k) {
+    const double th = 0.5 * k * kDt;  // 0.5 rad/s on a 1 m radius
+    records[k].X_OR = Pose2(std::sin(th), 1.0 - std::cos(th), th);
+  }
+  slam::SlamParams params = Timing("realtime", "odometry");
+  ASSERT_GT(params.ekf.lateral_skid_s, 0.0);
+  SlamPair realtime(params, ModelCost(0.35), kDt, Pose2(), Pose2());
+  for (const SensorRecord& record : records) realtime.Step(record);
+  ASSERT_TRUE(realtime.processed(0));
+
+  // The reference: the first record, then the last with dt = 0.4 s.
+  const slam::ScanFeatures none;
+  slam::EkfSlam reference(params.ekf, slam::CorrectionMode::kClassical, Pose2(), Pose2());
+  reference.Step(records[0], &none);
+  SensorRecord last = records[4];
+  last.dt_s = 4 * kDt;
+  reference.Step(last, &none);
+  EXPECT_NEAR(realtime.filter(0).X_WR().x, reference.X_WR().x, 1e-15);
+  EXPECT_NEAR(realtime.filter(0).X_WR().y, reference.X_WR().y, 1e-15);
+  // With the last step's dt alone the skid would be 4 times larger.
+  slam::EkfSlam short_dt(params.ekf, slam::CorrectionMode::kClassical, Pose2(), Pose2());
+  short_dt.Step(records[0], &none);
+  short_dt.Step(records[4], &none);
+  EXPECT_GT(std::abs(short_dt.X_WR().y - reference.X_WR().y), 1e-6);
+}
+
 }  // namespace
 }  // namespace mjslam::app
