@@ -271,6 +271,8 @@ rundir::RunSummary ClosedLoop::Summary(bool interrupted) const {
     filter.num_features = slam_->filter(f).num_features();
     filter.processing_s = slam_->total_processing_s(f);
     filter.open_loop_s = slam_->open_loop_s(f);
+    filter.scans_processed = slam_->scans_processed(f);
+    filter.scans_skipped = slam_->scans_skipped(f);
     summary.filters.push_back(filter);
   }
   return summary;

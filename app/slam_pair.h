@@ -13,11 +13,29 @@
 
 namespace mjslam::app {
 
+/// When each filter runs (`slam.timing`; docs/method.md, "Real-time filter
+/// timing").
+enum class FilterTiming {
+  /// Every filter processes every record, whatever its processing time.
+  kEveryScan,
+  /// A filter that processed a record at step s is busy until step s + its
+  /// command period: the records of the steps in between are not processed
+  /// (their scans are skipped); their motion enters the prediction of the
+  /// next record it processes.
+  kRealtime,
+};
+
+/// The FilterTiming of the `slam.timing` text ("every_scan", "realtime");
+/// SlamParams::Validate() has checked it. Aborts on any other text.
+FilterTiming FilterTimingFromText(const std::string& text);
+
 /// The two filters of the paper on the same records: the classical sequential
 /// EKF and the selective one. Features are extracted once per scan and given
 /// to both; each filter's processing time is that extraction plus its own
 /// step, measured with a steady clock. Each filter's processing time also
-/// gives the command period it would impose (ControlParams).
+/// gives the command period it would impose (ControlParams). With
+/// `slam.timing: realtime` each filter runs on its own timeline
+/// (FilterTiming::kRealtime).
 class SlamPair {
  public:
   /// X_WR0: known initial pose of R; X_RS: the laser mount on R; `dt_s` the
@@ -25,12 +43,22 @@ class SlamPair {
   SlamPair(const slam::SlamParams& params, const ControlParams& control, double dt_s,
            const Pose2& X_WR0, const Pose2& X_RS);
 
-  /// Runs both filters on one record.
+  /// Runs both filters on one record, the record of the next control step
+  /// (the first call is step 0). In realtime timing, a filter still busy
+  /// with an earlier record skips this one (processed(i) is false after the
+  /// call): its estimate and map stay those of its last processed record.
+  /// A filter that is free predicts over every step since its last processed
+  /// record, then processes this one: with `input: command`, one
+  /// prediction per skipped record with that record's own command and dt;
+  /// with `input: odometry`, one prediction from the odometry pose of its
+  /// last processed record to this one's, dt the time between them.
   void Step(const SensorRecord& record);
 
   /// Both filters' columns of trajectory.csv after the last step, in the
   /// order of rundir::FilterNames(); X_WR_true is the true pose of R for
-  /// the NEES.
+  /// the NEES. A filter that skipped the step reports its last processed
+  /// estimate, covariance and map size, 0 matched, updated and microseconds,
+  /// the period still running, and processed = false.
   std::vector<rundir::FilterRow> Rows(const Pose2& X_WR_true) const;
 
   /// Processing time of filter `i` (0 classical, 1 selective) for the last
@@ -44,6 +72,14 @@ class SlamPair {
   /// control step runs open loop), seconds.
   double total_processing_s(int i) const { return filters_[i].total_processing_s; }
   double open_loop_s(int i) const { return filters_[i].open_loop_s; }
+  /// Whether filter `i` processed the last step's record (always in
+  /// every_scan timing), and its counts so far of scans processed and of
+  /// scans skipped because it was busy.
+  bool processed(int i) const { return filters_[i].processed; }
+  int scans_processed(int i) const { return filters_[i].scans_processed; }
+  int scans_skipped(int i) const { return filters_[i].scans_skipped; }
+  /// The timing the pair runs with.
+  FilterTiming timing() const { return timing_; }
   /// Filter `i` by index, and its name.
   const slam::EkfSlam& filter(int i) const { return filters_[i].filter; }
   const std::string& name(int i) const { return filters_[i].name; }
@@ -64,10 +100,27 @@ class SlamPair {
     double total_processing_s = 0.0;
     double open_loop_s = 0.0;
     int steps_to_next_command = 0;
+    // Realtime timing: the first step at which the filter is free again,
+    // the time of its last processed record, and (command input) the
+    // records of the steps it skipped since, without their scans.
+    int next_free_step = 0;
+    double last_processed_t_s = 0.0;
+    std::vector<SensorRecord> skipped_records;
+    bool processed = true;
+    int scans_processed = 0;
+    int scans_skipped = 0;
   };
+  // Realtime timing: filter `f` catches up over the records it skipped and
+  // processes `record`, the record of control step `step` (the features
+  // when it has a scan). Returns the filter's step report.
+  slam::StepReport CatchUpAndStep(Filter* f, int step, const SensorRecord& record,
+                                  const slam::ScanFeatures* features);
+
   slam::SlamParams params_;
   ControlParams control_;
   double dt_s_;
+  FilterTiming timing_;
+  int step_ = 0;  // index of the next record
   std::vector<Filter> filters_;
 };
 

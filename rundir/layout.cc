@@ -18,7 +18,8 @@ std::vector<std::string> RecordedTrajectoryColumns() {
 const std::vector<std::string>& FilterColumnSuffixes() {
   static const std::vector<std::string> kSuffixes = {
       "x",     "y",        "th",        "pxx", "pxy",    "pxth",      "pyy", "pyth",
-      "pthth", "nfeat",    "nmatched",  "nupdated", "us", "period", "open_loop", "nees"};
+      "pthth", "nfeat",    "nmatched",  "nupdated", "us", "period", "open_loop", "nees",
+      "processed"};
   return kSuffixes;
 }
 

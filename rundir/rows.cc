@@ -46,6 +46,7 @@ void AddTrajectoryRow(const TrajectoryRow& row, CsvWriter* trajectory) {
     } else {
       trajectory->AddEmpty();
     }
+    trajectory->Add(f.processed ? 1 : 0);
   }
   trajectory->EndRow();
 }

@@ -32,6 +32,10 @@ struct FilterRow {
   double open_loop_s = 0.0;
   /// Pose NEES of the step (3 dof); not finite: written as an empty field.
   double nees = 0.0;
+  /// Whether the filter processed the step's record (written 1 or 0): false
+  /// when, in realtime timing, it was still busy with an earlier one and
+  /// the fields above hold its last processed estimate.
+  bool processed = true;
 };
 
 /// One row of trajectory.csv (TrajectoryColumns()).

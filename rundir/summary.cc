@@ -29,7 +29,9 @@ nlohmann::json ToJson(const RunSummary& summary) {
         {"final_pose_error", {{"x", f.error_x}, {"y", f.error_y}, {"th", f.error_th}}},
         {"num_features", f.num_features},
         {"processing_s", f.processing_s},
-        {"open_loop_s", f.open_loop_s}};
+        {"open_loop_s", f.open_loop_s},
+        {"scans_processed", f.scans_processed},
+        {"scans_skipped", f.scans_skipped}};
   }
   return json;
 }

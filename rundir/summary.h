@@ -43,6 +43,10 @@ struct RunSummary {
     /// time on its own command timeline, seconds.
     double processing_s = 0.0;
     double open_loop_s = 0.0;
+    /// Scans the filter processed, and scans it skipped because it was busy
+    /// (realtime timing; 0 with every_scan).
+    int scans_processed = 0;
+    int scans_skipped = 0;
   };
   std::vector<Filter> filters;
 };

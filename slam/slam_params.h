@@ -182,23 +182,32 @@ struct EkfParams {
 };
 
 /// Everything the SLAM needs: feature extraction and filter parameters.
-/// Serialized under `slam.*` (`slam.features.*`, `slam.ekf.*`).
+/// Serialized under `slam.*` (`slam.features.*`, `slam.ekf.*`, `slam.timing`).
 struct SlamParams {
   /// Line and corner extraction (`slam.features.*`).
   FeatureExtractionParams features;
   /// The filters (`slam.ekf.*`).
   EkfParams ekf;
+  /// When each filter runs (docs/method.md, "Real-time filter timing"):
+  /// "every_scan" (every filter processes every record, whatever its
+  /// processing time) or "realtime" (a filter busy with a scan for its
+  /// command period skips the scans that arrive meanwhile). The string lives
+  /// only here, where YAML is read; app/slam_pair.h turns it into an enum.
+  std::string timing = "every_scan";
 
   template <typename Archive>
   void Serialize(Archive* a) {
     a->Visit(MJSLAM_NVP(features));
     a->Visit(MJSLAM_NVP(ekf));
+    a->Visit(MJSLAM_NVP(timing));
   }
-  /// Problems of both parts, keys prefixed `features.` and `ekf.`.
+  /// Problems of both parts, keys prefixed `features.` and `ekf.`, and of
+  /// `timing`.
   std::vector<ParamProblem> Validate() const {
     ParamChecker check;
     check.Merge("features", features.Validate());
     check.Merge("ekf", ekf.Validate());
+    check.OneOf("timing", timing, {"every_scan", "realtime"});
     return check.problems();
   }
   /// Throws ParamError listing every problem of Validate().

@@ -1,7 +1,11 @@
 // The closed-loop engine on a short run of the default world: the clock holds
-// each command for the driving filter's command period, and the same loop on
-// a recording of the run gives the filters the same records bit for bit.
+// each command for the driving filter's command period, the same loop on a
+// recording of the run gives the filters the same records bit for bit (in
+// both slam.timing modes), and in realtime timing each filter processes
+// exactly the records at the ends of its periods.
+#include <algorithm>
 #include <cmath>
+#include <string>
 #include <filesystem>
 #include <vector>
 
@@ -24,10 +28,24 @@ namespace fs = std::filesystem;
 // at once (no initial turn), whose processing takes 0.25 s on every step (a
 // scan on every step, no cost per correction): a command period of 3
 // control steps.
-RunConfig ShortConfig() {
-  RunConfig config = LoadRunConfig(std::string(MJSLAM_SOURCE_DIR) + "/configs/default.yaml",
-                                   {"run.duration_s=3", "explorer.initial_turn_deg=0", "control.model_base_s=0.25",
-                                    "control.model_s_per_update_per_n2=0"});
+RunConfig ShortConfig(const std::vector<std::string>& extra = {}) {
+  std::vector<std::string> overrides = {"run.duration_s=3", "explorer.initial_turn_deg=0",
+                                        "control.model_base_s=0.25",
+                                        "control.model_s_per_update_per_n2=0"};
+  overrides.insert(overrides.end(), extra.begin(), extra.end());
+  RunConfig config =
+      LoadRunConfig(std::string(MJSLAM_SOURCE_DIR) + "/configs/default.yaml", overrides);
+  config.ValidateOrThrow();
+  return config;
+}
+
+// Realtime timing, 8 s, the default cost model (a period that grows with the
+// map and differs between the filters), `input` as given.
+RunConfig RealtimeConfig(const std::string& input) {
+  RunConfig config = LoadRunConfig(
+      std::string(MJSLAM_SOURCE_DIR) + "/configs/default.yaml",
+      {"run.duration_s=8", "explorer.initial_turn_deg=0", "slam.timing=realtime",
+       "control.model_s_per_update_per_n2=4e-5", "slam.ekf.input=" + input});
   config.ValidateOrThrow();
   return config;
 }
@@ -55,9 +73,12 @@ TEST(ClosedLoopTest, HoldsEachCommandForTheDrivingFiltersPeriod) {
   EXPECT_GT(changes, 2);  // the robot is driven, or the test proves nothing
 }
 
-TEST(ClosedLoopTest, TheLoopOnARecordingGivesTheFiltersTheSameRecords) {
-  const RunConfig config = ShortConfig();
-  const std::string dir = (fs::temp_directory_path() / "mjslam_closed_loop_test").string();
+// Runs `config` in the simulated loop, writes its recording as a run does,
+// and runs the loop on that recording: every filter column must agree bit
+// for bit. Returns the simulated rows.
+std::vector<rundir::TrajectoryRow> ExpectRecordingReproducesTheFilters(const RunConfig& config,
+                                                                       const std::string& name) {
+  const std::string dir = (fs::temp_directory_path() / name).string();
   fs::remove_all(dir);
   fs::create_directories(dir);
 
@@ -89,20 +110,66 @@ TEST(ClosedLoopTest, TheLoopOnARecordingGivesTheFiltersTheSameRecords) {
   std::size_t k = 0;
   for (; !replay.Done(); ++k) {
     const rundir::TrajectoryRow& row = replay.Step().row;
-    ASSERT_LT(k, simulated.size());
+    if (k >= simulated.size()) {
+      ADD_FAILURE() << "the replay has more steps than the run";
+      break;
+    }
     EXPECT_EQ(row.command.v_mps, simulated[k].command.v_mps) << "step " << k;
     for (int f = 0; f < 2; ++f) {
       const rundir::FilterRow& a = row.filters[f];
       const rundir::FilterRow& b = simulated[k].filters[f];
       EXPECT_EQ(a.X_WR.x, b.X_WR.x) << "step " << k << " filter " << f;
+      EXPECT_EQ(a.X_WR.y, b.X_WR.y) << "step " << k << " filter " << f;
       EXPECT_EQ(a.X_WR.theta, b.X_WR.theta) << "step " << k << " filter " << f;
       EXPECT_EQ(a.P, b.P) << "step " << k << " filter " << f;
       EXPECT_EQ(a.num_matched, b.num_matched) << "step " << k << " filter " << f;
+      EXPECT_EQ(a.period_s, b.period_s) << "step " << k << " filter " << f;
+      EXPECT_EQ(a.processed, b.processed) << "step " << k << " filter " << f;
     }
   }
   EXPECT_EQ(k, simulated.size());
   EXPECT_GT(simulated.back().filters[1].num_features, 0);
   fs::remove_all(dir);
+  return simulated;
+}
+
+TEST(ClosedLoopTest, TheLoopOnARecordingGivesTheFiltersTheSameRecords) {
+  ExpectRecordingReproducesTheFilters(ShortConfig(), "mjslam_closed_loop_test");
+}
+
+// Realtime timing with both inputs: a filter processes step 0 and then
+// exactly the step where the period of its last processed step has run out;
+// it skips every scan in between; the replay reproduces it bit for bit.
+TEST(ClosedLoopTest, RealtimeFiltersProcessAtTheEndOfEachPeriodAndReplayBitForBit) {
+  for (const std::string input : {"command", "odometry"}) {
+    const RunConfig config = RealtimeConfig(input);
+    const std::vector<rundir::TrajectoryRow> rows =
+        ExpectRecordingReproducesTheFilters(config, "mjslam_closed_loop_realtime_" + input);
+    ASSERT_EQ(rows.size(), 81u);
+    std::vector<int> skipped(2, 0);
+    std::vector<int> longest_period(2, 0);
+    for (int f = 0; f < 2; ++f) {
+      int next = 0;
+      for (int k = 0; k < static_cast<int>(rows.size()); ++k) {
+        const rundir::FilterRow& row = rows[k].filters[f];
+        ASSERT_EQ(row.processed, k == next) << input << " filter " << f << " step " << k;
+        if (row.processed) {
+          const int period = static_cast<int>(std::lround(row.period_s * 10.0));
+          next = k + period;
+          longest_period[f] = std::max(longest_period[f], period);
+        } else {
+          ++skipped[f];
+          EXPECT_EQ(row.X_WR.x, rows[k - 1].filters[f].X_WR.x) << "held, step " << k;
+          EXPECT_EQ(row.num_updated, 0);
+        }
+      }
+    }
+    // The classical filter's period grows beyond the selective one's, so
+    // it skips more scans (or the test proves nothing).
+    EXPECT_GT(longest_period[0], 1) << input;
+    EXPECT_GT(skipped[0], skipped[1]) << input;
+    EXPECT_GT(skipped[1], 0) << input;
+  }
 }
 
 }  // namespace

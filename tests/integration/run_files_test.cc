@@ -62,7 +62,7 @@ TEST_F(RunFilesTest, WritesEveryFileWithTheDocumentedColumns) {
   const CsvTable trajectory = ReadCsv(rundir::PathIn(*first_, rundir::kTrajectoryFile));
   EXPECT_EQ(trajectory.columns, rundir::TrajectoryColumns());
   EXPECT_EQ(trajectory.columns[9], "explored");
-  EXPECT_EQ(trajectory.columns.back(), "selective_nees");
+  EXPECT_EQ(trajectory.columns.back(), "selective_processed");
   EXPECT_EQ(ReadCsv(rundir::PathIn(*first_, rundir::kExplorerFile), {"kind"}).columns, rundir::ExplorerColumns());
   // 12 s at 10 Hz: steps at t = 0, 0.1, ..., 12.
   ASSERT_EQ(trajectory.rows.size(), 121u);
@@ -127,6 +127,47 @@ TEST_F(RunFilesTest, ReplayReproducesTheFilters) {
                   DropColumns(ReadCsv(rundir::PathIn(dir, rundir::kTrajectoryFile)), "_us"));
   EXPECT_EQ(ReadText(rundir::PathIn(*first_, rundir::MapFile("selective"))), ReadText(rundir::PathIn(dir, rundir::MapFile("selective"))));
   EXPECT_EQ(ReadText(rundir::PathIn(*first_, rundir::MapFile("classical"))), ReadText(rundir::PathIn(dir, rundir::MapFile("classical"))));
+}
+
+// A realtime run (slam.timing: realtime, a cost model whose periods grow
+// with the map) and its replay: the same trajectory bit for bit (but the
+// measured times) and the same maps; summary.json counts each filter's
+// processed and skipped scans as trajectory.csv's f_processed says.
+TEST(RealtimeRunTest, ReplayReproducesARealtimeRunBitForBit) {
+  const std::string run = FreshDir("realtime_run");
+  ASSERT_EQ(ShortRun(run, 7,
+                     "--set slam.timing=realtime --set control.model_s_per_update_per_n2=4e-5"),
+            0)
+      << ReadText(run + ".log");
+  const std::string dir = FreshDir("realtime_replay");
+  ASSERT_EQ(Shell(Program() + " replay --scans " + run + "/scans.csv --config " + run +
+                  "/config.yaml --out " + dir + " 2> " + dir + ".log"),
+            0)
+      << ReadText(dir + ".log");
+  const CsvTable trajectory = ReadCsv(rundir::PathIn(run, rundir::kTrajectoryFile));
+  ExpectSameTable(DropColumns(trajectory, "_us"),
+                  DropColumns(ReadCsv(rundir::PathIn(dir, rundir::kTrajectoryFile)), "_us"));
+  for (const std::string& name : rundir::FilterNames()) {
+    EXPECT_EQ(ReadText(rundir::PathIn(run, rundir::MapFile(name))),
+              ReadText(rundir::PathIn(dir, rundir::MapFile(name))))
+        << name;
+  }
+
+  const nlohmann::json summary =
+      nlohmann::json::parse(ReadText(rundir::PathIn(run, rundir::kSummaryFile)));
+  for (const std::string& name : rundir::FilterNames()) {
+    const int column = trajectory.ColumnIndex(name + "_processed");
+    int processed = 0;
+    for (const std::vector<double>& row : trajectory.rows) processed += row[column] == 1.0 ? 1 : 0;
+    const nlohmann::json& filter = summary["filters"][name];
+    EXPECT_EQ(filter["scans_processed"].get<int>(), processed) << name;
+    EXPECT_EQ(filter["scans_processed"].get<int>() + filter["scans_skipped"].get<int>(),
+              static_cast<int>(trajectory.rows.size()))
+        << name;
+  }
+  // The classical filter, slower, skips more (or the test proves nothing).
+  EXPECT_GT(summary["filters"]["classical"]["scans_skipped"].get<int>(),
+            summary["filters"]["selective"]["scans_skipped"].get<int>());
 }
 
 TEST(RunFailureTest, InterruptedRunKeepsCompleteRowsAndSaysSo) {
