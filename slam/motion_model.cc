@@ -6,10 +6,47 @@
 #include "slam/fast_wrap.h"
 
 namespace mjslam::slam {
+namespace {
+
+// The paper's forward-Euler Eq. (6) over one step, with the heading th at the
+// start of the period, plus the skid across that heading; A and W as in
+// PredictPose.
+Eigen::Vector3d PredictPoseEuler(const Eigen::Vector3d& pose_WR, const Eigen::Vector2d& increment,
+                                 double a_m, Eigen::Matrix3d* A, Eigen::Matrix<double, 3, 2>* W,
+                                 double skid_per_m_rad) {
+  const double d = increment.x();
+  const double dth = increment.y();
+  const double c = std::cos(pose_WR.z());
+  const double s = std::sin(pose_WR.z());
+  // Sideways: a dth for the point h ahead of the axle, and the skid outward.
+  const double lateral = a_m * dth - skid_per_m_rad * d * dth;
+  const double dx = d * c - lateral * s;
+  const double dy = d * s + lateral * c;
+  const Eigen::Vector3d predicted(pose_WR.x() + dx, pose_WR.y() + dy,
+                                  WrapAngleFast(pose_WR.z() + dth));
+  if (A != nullptr) {
+    A->setIdentity();
+    (*A)(0, 2) = -dy;
+    (*A)(1, 2) = dx;
+  }
+  if (W != nullptr) {
+    const double dlat_dd = -skid_per_m_rad * dth;
+    const double dlat_dth = a_m - skid_per_m_rad * d;
+    *W << c - dlat_dd * s, -dlat_dth * s,
+          s + dlat_dd * c, dlat_dth * c,
+          0.0, 1.0;
+  }
+  return predicted;
+}
+
+}  // namespace
 
 Eigen::Vector3d PredictPose(const Eigen::Vector3d& pose_WR, const Eigen::Vector2d& increment,
                             double a_m, Eigen::Matrix3d* A, Eigen::Matrix<double, 3, 2>* W,
-                            double skid_per_m_rad) {
+                            double skid_per_m_rad, MotionIntegration integration) {
+  if (integration == MotionIntegration::kEuler) {
+    return PredictPoseEuler(pose_WR, increment, a_m, A, W, skid_per_m_rad);
+  }
   const double d = increment.x();
   const double dth = increment.y();
   const double half = 0.5 * dth;
