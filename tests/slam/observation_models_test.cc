@@ -327,56 +327,42 @@ TEST(MotionModelTest, EulerIsThePapersEquationSixWithTheStartHeading) {
   EXPECT_NEAR(skidded.y(), euler.y(), 1e-15);
 }
 
-TEST(MotionModelTest, EulerJacobiansAAndWMatchCentralDifferences) {
-  Rng rng(17);
-  for (int trial = 0; trial < 100; ++trial) {
-    const Eigen::Vector3d pose = RandomPose(&rng);
-    const Eigen::Vector2d increment(rng.Gaussian(0.0, 0.5), rng.Gaussian(0.0, 0.5));
-    const double a = 0.05 + 0.3 * rng.Uniform();
-    const double skid = trial % 2 == 0 ? 0.0 : 0.2 * rng.Uniform();  // with and without
-    const MotionIntegration euler = MotionIntegration::kEuler;
-    Eigen::Matrix3d A;
-    Eigen::Matrix<double, 3, 2> W;
-    PredictPose(pose, increment, a, &A, &W, skid, euler);
-    const Eigen::Matrix3d numerical_A = NumericalJacobian<3, 3>(
-        [&](const Eigen::Vector3d& p) {
-          return PredictPose(p, increment, a, nullptr, nullptr, skid, euler);
-        },
-        pose, {2});
-    const Eigen::Matrix<double, 3, 2> numerical_W = NumericalJacobian<3, 2>(
-        [&](const Eigen::Vector2d& u) {
-          return PredictPose(pose, u, a, nullptr, nullptr, skid, euler);
-        },
-        increment, {2});
-    EXPECT_LT((A - numerical_A).cwiseAbs().maxCoeff(), kJacobianTolerance) << "trial " << trial;
-    EXPECT_LT((W - numerical_W).cwiseAbs().maxCoeff(), kJacobianTolerance) << "trial " << trial;
-    // Not the exact model's Jacobians: W differs in a turn.
-    Eigen::Matrix<double, 3, 2> W_exact;
-    PredictPose(pose, increment, a, nullptr, &W_exact, skid);
-    if (std::abs(increment.y()) > 0.1) {
-      EXPECT_GT((W - W_exact).cwiseAbs().maxCoeff(), 1e-3) << "trial " << trial;
-    }
-  }
-}
-
 TEST(MotionModelTest, JacobiansAAndWMatchCentralDifferences) {
-  Rng rng(16);
-  for (int trial = 0; trial < 100; ++trial) {
-    const Eigen::Vector3d pose = RandomPose(&rng);
-    const Eigen::Vector2d increment(rng.Gaussian(0.0, 0.5), rng.Gaussian(0.0, 0.5));
-    const double a = 0.05 + 0.3 * rng.Uniform();
-    const double skid = trial % 2 == 0 ? 0.0 : 0.2 * rng.Uniform();  // with and without
-    Eigen::Matrix3d A;
-    Eigen::Matrix<double, 3, 2> W;
-    PredictPose(pose, increment, a, &A, &W, skid);
-    const Eigen::Matrix3d numerical_A = NumericalJacobian<3, 3>(
-        [&](const Eigen::Vector3d& p) { return PredictPose(p, increment, a, nullptr, nullptr, skid); },
-        pose, {2});
-    const Eigen::Matrix<double, 3, 2> numerical_W = NumericalJacobian<3, 2>(
-        [&](const Eigen::Vector2d& u) { return PredictPose(pose, u, a, nullptr, nullptr, skid); },
-        increment, {2});
-    EXPECT_LT((A - numerical_A).cwiseAbs().maxCoeff(), kJacobianTolerance) << "trial " << trial;
-    EXPECT_LT((W - numerical_W).cwiseAbs().maxCoeff(), kJacobianTolerance) << "trial " << trial;
+  // Both integrations, each with its own A and W.
+  for (const MotionIntegration integration :
+       {MotionIntegration::kExact, MotionIntegration::kEuler}) {
+    SCOPED_TRACE(integration == MotionIntegration::kEuler ? "euler" : "exact");
+    Rng rng(16);
+    for (int trial = 0; trial < 100; ++trial) {
+      const Eigen::Vector3d pose = RandomPose(&rng);
+      const Eigen::Vector2d increment(rng.Gaussian(0.0, 0.5), rng.Gaussian(0.0, 0.5));
+      const double a = 0.05 + 0.3 * rng.Uniform();
+      const double skid = trial % 2 == 0 ? 0.0 : 0.2 * rng.Uniform();  // with and without
+      Eigen::Matrix3d A;
+      Eigen::Matrix<double, 3, 2> W;
+      PredictPose(pose, increment, a, &A, &W, skid, integration);
+      const Eigen::Matrix3d numerical_A = NumericalJacobian<3, 3>(
+          [&](const Eigen::Vector3d& p) {
+            return PredictPose(p, increment, a, nullptr, nullptr, skid, integration);
+          },
+          pose, {2});
+      const Eigen::Matrix<double, 3, 2> numerical_W = NumericalJacobian<3, 2>(
+          [&](const Eigen::Vector2d& u) {
+            return PredictPose(pose, u, a, nullptr, nullptr, skid, integration);
+          },
+          increment, {2});
+      EXPECT_LT((A - numerical_A).cwiseAbs().maxCoeff(), kJacobianTolerance) << "trial " << trial;
+      EXPECT_LT((W - numerical_W).cwiseAbs().maxCoeff(), kJacobianTolerance) << "trial " << trial;
+      // The two models' W differ in a turn: each test checks its own.
+      const MotionIntegration other = integration == MotionIntegration::kEuler
+                                          ? MotionIntegration::kExact
+                                          : MotionIntegration::kEuler;
+      Eigen::Matrix<double, 3, 2> W_other;
+      PredictPose(pose, increment, a, nullptr, &W_other, skid, other);
+      if (std::abs(increment.y()) > 0.1) {
+        EXPECT_GT((W - W_other).cwiseAbs().maxCoeff(), 1e-3) << "trial " << trial;
+      }
+    }
   }
 }
 
