@@ -24,7 +24,8 @@ namespace mjslam::slam {
 enum class CorrectionMode {
   /// Algorithm 1: every matched observation, sequentially.
   kClassical,
-  /// Algorithm 2: the `max_updates` most informative matched observations.
+  /// Algorithm 2: the `max_updates` most informative matched observations
+  /// (or those of another EkfParams::selection_policy, for ablations).
   kSelective,
 };
 
