@@ -37,6 +37,18 @@ double SelectionCriterion(const SlamState& state, const MatchedObservation& obse
       observation.R);
 }
 
+double PoseDeterminantAfter(const SlamState& state, const MatchedObservation& observation) {
+  const SlamState::Measurement m = state.MeasureFor(observation.feature, observation.z);
+  MJSLAM_CHECK(m.valid);
+  Eigen::Matrix<double, 2, 5> H_b;
+  H_b << m.H_pose, m.H_feature;
+  const Eigen::Matrix2d S = m.HPHt + observation.R;
+  const Eigen::Matrix<double, 5, 5> P_b = state.JointCovariance(observation.feature);
+  const Eigen::Matrix<double, 3, 2> C = P_b.topRows<3>() * H_b.transpose();
+  const Eigen::Matrix3d P_pp = P_b.topLeftCorner<3, 3>() - C * S.inverse() * C.transpose();
+  return P_pp.determinant();
+}
+
 int CorrectClassical(SlamState* state, const std::vector<MatchedObservation>& matched) {
   for (const MatchedObservation& observation : matched) {
     state->Update(observation.feature, observation.z, observation.R);
@@ -44,25 +56,52 @@ int CorrectClassical(SlamState* state, const std::vector<MatchedObservation>& ma
   return static_cast<int>(matched.size());
 }
 
+namespace {
+
+// The position in `remaining` of the candidate `policy` chooses under the
+// current state (CorrectSelective documents the policies).
+int ChooseCandidate(const SlamState& state, const std::vector<MatchedObservation>& matched,
+                    const std::vector<int>& remaining, SelectionPolicy policy, Rng* rng) {
+  const int count = static_cast<int>(remaining.size());
+  if (policy == SelectionPolicy::kFirst) return 0;
+  if (policy == SelectionPolicy::kRandom) {
+    MJSLAM_CHECK(rng != nullptr);
+    return std::min(count - 1, static_cast<int>(rng->Uniform() * count));
+  }
+  // The argmin of a score, ties to the first.
+  int best = -1;
+  double best_score = std::numeric_limits<double>::infinity();
+  for (int i = 0; i < count; ++i) {
+    const MatchedObservation& candidate = matched[remaining[i]];
+    double score;
+    if (policy == SelectionPolicy::kDeterminant) {
+      score = PoseDeterminantAfter(state, candidate);
+    } else if (policy == SelectionPolicy::kLeastInformative) {
+      score = -SelectionCriterion(state, candidate);
+    } else {
+      // The paper's: the smallest eigenvalue sum.
+      score = SelectionCriterion(state, candidate);
+    }
+    if (score < best_score) {
+      best_score = score;
+      best = i;
+    }
+  }
+  MJSLAM_CHECK(best >= 0);
+  return best;
+}
+
+}  // namespace
+
 std::vector<int> CorrectSelective(SlamState* state, const std::vector<MatchedObservation>& matched,
-                                  int max_updates) {
+                                  int max_updates, SelectionPolicy policy, Rng* rng) {
   MJSLAM_CHECK(max_updates >= 1);
   std::vector<int> remaining(matched.size());
   for (std::size_t i = 0; i < matched.size(); ++i) remaining[i] = static_cast<int>(i);
   std::vector<int> used;
   const int rounds = std::min(static_cast<int>(matched.size()), max_updates);
   for (int round = 0; round < rounds; ++round) {
-    // The candidate with the smallest eigenvalue sum under the current P.
-    int best = -1;
-    double best_criterion = std::numeric_limits<double>::infinity();
-    for (std::size_t i = 0; i < remaining.size(); ++i) {
-      const double criterion = SelectionCriterion(*state, matched[remaining[i]]);
-      if (criterion < best_criterion) {
-        best_criterion = criterion;
-        best = static_cast<int>(i);
-      }
-    }
-    MJSLAM_CHECK(best >= 0);
+    const int best = ChooseCandidate(*state, matched, remaining, policy, rng);
 
     // Correct with it (as in Algorithm 1) and drop it from the candidates.
     const MatchedObservation& chosen = matched[remaining[best]];

@@ -4,6 +4,8 @@
 
 #include <Eigen/Core>
 
+#include "common/rng.h"
+#include "slam/slam_params.h"
 #include "slam/slam_state.h"
 
 namespace mjslam::slam {
@@ -38,17 +40,29 @@ Eigen::Matrix<double, 5, 5> SelectionBlock(const Eigen::Matrix<double, 5, 5>& P_
 /// mean of `state`. O(1).
 double SelectionCriterion(const SlamState& state, const MatchedObservation& observation);
 
+/// det of the pose covariance P_pp after correcting `state` with
+/// `observation`: det(P_pp - C S^-1 C^T), C = P_(pose,b) H_b^T the pose rows
+/// of P H^T, S = H P H^T + R. The determinant policy's score; smaller means
+/// the correction shrinks the pose's uncertainty volume more. O(1).
+double PoseDeterminantAfter(const SlamState& state, const MatchedObservation& observation);
+
 /// Algorithm 1 (classical sequential EKF): corrects `state` with every
 /// matched observation, in order, each re-linearised at the current mean.
 /// Returns the number of corrections (matched.size()). O(|M| n^2).
 int CorrectClassical(SlamState* state, const std::vector<MatchedObservation>& matched);
 
 /// Algorithm 2 (feature updating selection): min(|M|, max_updates) times,
-/// computes the criterion of every remaining candidate with the current P,
-/// corrects with the argmin (ties: the first), and removes it. Returns the
-/// indices into `matched` in the order they were used. O(MAX (|M| + n^2)).
-/// Precondition (checked): max_updates >= 1.
+/// chooses one remaining candidate by `policy`, corrects with it and removes
+/// it. kCriterion (the paper's): the argmin of the criterion under the
+/// current P; kLeastInformative: its argmax; kDeterminant: the argmin of
+/// PoseDeterminantAfter under the current P; kFirst: the first remaining
+/// (extraction order); kRandom: one drawn uniformly from `rng`. Ties go to
+/// the first. Returns the indices into `matched` in the order they were
+/// used. O(MAX (|M| + n^2)).
+/// Preconditions (checked): max_updates >= 1; `rng` not null for kRandom.
 std::vector<int> CorrectSelective(SlamState* state, const std::vector<MatchedObservation>& matched,
-                                  int max_updates);
+                                  int max_updates,
+                                  SelectionPolicy policy = SelectionPolicy::kCriterion,
+                                  Rng* rng = nullptr);
 
 }  // namespace mjslam::slam

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <limits>
 #include <string>
+#include <utility>
 
 #include "common/angles.h"
 #include "common/params.h"
@@ -57,9 +58,12 @@ void RequireFinite(double value, const std::string& what) {
 }  // namespace
 
 EkfSlam::EkfSlam(const EkfParams& params, CorrectionMode mode, const Pose2& X_WR0,
-                 const Pose2& X_RS)
+                 const Pose2& X_RS, Rng rng)
     : params_(Validated(params)),
       mode_(mode),
+      integration_(MotionIntegrationFromName(params.motion_integration)),
+      policy_(SelectionPolicyFromName(params.selection_policy)),
+      rng_(std::move(rng)),
       state_(Eigen::Vector3d(X_WR0.x, X_WR0.y, X_WR0.theta),
              Eigen::Vector3d(params.initial_position_std_m * params.initial_position_std_m,
                              params.initial_position_std_m * params.initial_position_std_m,
@@ -192,6 +196,7 @@ MotionInput EkfSlam::CheckedMotionInput(const SensorRecord& record) const {
   const double slip_std = params_.lateral_slip_std_m_per_rad * std::abs(input.increment.y());
   input.lateral_variance_m2 = slip_std * slip_std;
   if (record.dt_s > 0.0) input.skid_per_m_rad = params_.lateral_skid_s / record.dt_s;
+  input.integration = integration_;
   return input;
 }
 
@@ -298,7 +303,7 @@ StepReport EkfSlam::Step(const SensorRecord& record, const ScanFeatures* feature
     report.num_updated = CorrectClassical(&state_, matched);
   } else {
     report.num_updated =
-        static_cast<int>(CorrectSelective(&state_, matched, params_.max_updates).size());
+        static_cast<int>(CorrectSelective(&state_, matched, params_.max_updates, policy_, &rng_).size());
   }
 
   // Secondary map: every matched line's segment grows with what was seen,

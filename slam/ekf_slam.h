@@ -9,6 +9,7 @@
 #include "common/map_feature.h"
 #include "common/pose2.h"
 #include "common/records.h"
+#include "common/rng.h"
 #include "slam/corrections.h"
 #include "slam/data_association.h"
 #include "slam/motion_model.h"
@@ -23,7 +24,8 @@ namespace mjslam::slam {
 enum class CorrectionMode {
   /// Algorithm 1: every matched observation, sequentially.
   kClassical,
-  /// Algorithm 2: the `max_updates` most informative matched observations.
+  /// Algorithm 2: the `max_updates` most informative matched observations
+  /// (or those of another EkfParams::selection_policy, for ablations).
   kSelective,
 };
 
@@ -73,9 +75,13 @@ class EkfSlam {
   /// the laser mount on R. With `input: odometry`, only the increments of
   /// X_OR between consecutive records enter, so any fixed frame O works; the
   /// first record is their reference (it predicts no motion).
+  /// `rng`: the stream of the `random` selection policy (only the selective
+  /// filter with that policy draws from it); pass one forked from the run's
+  /// seed by name so that the filter stays deterministic by seed.
   /// Throws ParamError if `params` is invalid and SlamInputError if a pose is
   /// not finite.
-  EkfSlam(const EkfParams& params, CorrectionMode mode, const Pose2& X_WR0, const Pose2& X_RS);
+  EkfSlam(const EkfParams& params, CorrectionMode mode, const Pose2& X_WR0, const Pose2& X_RS,
+          Rng rng = Rng(0));
 
   /// Predicts from the record's input over record.dt_s (the command, or the
   /// odometry increment since the previous record), then, if `features` is
@@ -154,6 +160,9 @@ class EkfSlam {
 
   EkfParams params_;
   CorrectionMode mode_;
+  MotionIntegration integration_;  // params_.motion_integration
+  SelectionPolicy policy_;         // params_.selection_policy
+  Rng rng_;                        // draws of SelectionPolicy::kRandom
   SlamState state_;
   double gate_;
   double new_feature_threshold_;

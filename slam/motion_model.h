@@ -24,6 +24,8 @@ struct MotionInput {
   /// R moves by -skid d dth across the mid-arc heading (EkfParams::lateral_skid_s
   /// divided by dt). 0: Eq. (6) alone.
   double skid_per_m_rad = 0.0;
+  /// How Eq. (6) is integrated over the step (EkfParams::motion_integration).
+  MotionIntegration integration = MotionIntegration::kExact;
 };
 
 /// The paper's Eq. (6) for the point of control h (frame R, `a_m` ahead of
@@ -31,14 +33,17 @@ struct MotionInput {
 /// w dt):
 ///   x' = x + d cos th - a dth sin th,  y' = y + d sin th + a dth cos th,
 ///   th' = wrap(th + dth),
-/// integrated exactly (the axle centre on an arc, docs/method.md departure
-/// 9), plus a skid of -skid_per_m_rad d dth across the mid-arc heading
-/// (MotionInput::skid_per_m_rad).
-/// If not null, `A` receives d pose' / d pose and `W` d pose' / d increment.
+/// integrated exactly (kExact: the axle centre on an arc, docs/method.md
+/// departure 9), plus a skid of -skid_per_m_rad d dth across the mid-arc
+/// heading (MotionInput::skid_per_m_rad); or, with kEuler, the forward-Euler
+/// step above as the paper writes it, the skid then across the start heading
+/// th. If not null, `A` receives d pose' / d pose and `W` d pose' / d
+/// increment, of the integration chosen.
 Eigen::Vector3d PredictPose(const Eigen::Vector3d& pose_WR, const Eigen::Vector2d& increment,
                             double a_m, Eigen::Matrix3d* A = nullptr,
                             Eigen::Matrix<double, 3, 2>* W = nullptr,
-                            double skid_per_m_rad = 0.0);
+                            double skid_per_m_rad = 0.0,
+                            MotionIntegration integration = MotionIntegration::kExact);
 
 /// The command held over `dt_s` (>= 0) as an input: increment (v dt, w dt),
 /// covariance diag((dt sigma_v)^2, (dt sigma_w)^2) with

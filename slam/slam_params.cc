@@ -1,8 +1,35 @@
 #include "slam/slam_params.h"
 
 #include <cmath>
+#include <iterator>
+#include <vector>
 
 namespace mjslam::slam {
+namespace {
+
+// The index of `name` in `names`; throws ParamError naming `key` if absent.
+template <std::size_t N>
+int IndexOfName(const char* const (&names)[N], const std::string& name, const char* key) {
+  for (std::size_t i = 0; i < N; ++i) {
+    if (name == names[i]) return static_cast<int>(i);
+  }
+  ParamChecker check;
+  check.OneOf(key, name, std::vector<std::string>(names, names + N));
+  ThrowIfProblems(check.problems(), "slam.ekf");
+  return -1;  // not reached: the check above failed
+}
+
+}  // namespace
+
+MotionIntegration MotionIntegrationFromName(const std::string& name) {
+  return static_cast<MotionIntegration>(
+      IndexOfName(kMotionIntegrationNames, name, "motion_integration"));
+}
+
+SelectionPolicy SelectionPolicyFromName(const std::string& name) {
+  return static_cast<SelectionPolicy>(
+      IndexOfName(kSelectionPolicyNames, name, "selection_policy"));
+}
 
 std::vector<ParamProblem> CommandNoiseParams::Validate() const {
   ParamChecker check;
@@ -30,6 +57,9 @@ std::vector<ParamProblem> OdometryNoiseParams::Validate() const {
 std::vector<ParamProblem> EkfParams::Validate() const {
   ParamChecker check;
   check.OneOf("input", input, {"command", "odometry"});
+  check.OneOf("motion_integration", motion_integration,
+              std::vector<std::string>(std::begin(kMotionIntegrationNames),
+                                       std::end(kMotionIntegrationNames)));
   check.Positive("control_point_offset_m", control_point_offset_m);
   check.Require(std::isfinite(control_point_offset_m), "control_point_offset_m",
                 control_point_offset_m, "a finite value");
@@ -49,6 +79,9 @@ std::vector<ParamProblem> EkfParams::Validate() const {
                 "new_feature_probability", new_feature_probability,
                 "a probability in [gate_probability, 1)");
   check.Require(max_updates >= 1, "max_updates", max_updates, "a value >= 1");
+  check.OneOf("selection_policy", selection_policy,
+              std::vector<std::string>(std::begin(kSelectionPolicyNames),
+                                       std::end(kSelectionPolicyNames)));
   return check.problems();
 }
 

@@ -8,6 +8,44 @@
 
 namespace mjslam::slam {
 
+/// How the prediction integrates the paper's Eq. (6) over one step
+/// (`slam.ekf.motion_integration`; docs/method.md, departure 9).
+enum class MotionIntegration {
+  /// The axle centre on the arc the held input describes (the default).
+  kExact,
+  /// The paper's forward-Euler step, with the heading at the start of the
+  /// period.
+  kEuler,
+};
+
+/// Which MAX matched observations the selective filter corrects with
+/// (`slam.ekf.selection_policy`; docs/method.md, "Selection policies").
+enum class SelectionPolicy {
+  /// The paper's: repeatedly the smallest sum(eig(B)) under the current P.
+  kCriterion,
+  /// The first MAX in extraction order (lines, then corners).
+  kFirst,
+  /// MAX drawn uniformly without replacement from a seeded stream.
+  kRandom,
+  /// Repeatedly the largest sum(eig(B)): the least informative.
+  kLeastInformative,
+  /// Repeatedly the one leaving the smallest det of the pose covariance.
+  kDeterminant,
+};
+
+/// The names the YAML uses, in enum order.
+inline constexpr const char* kMotionIntegrationNames[] = {"exact", "euler"};
+/// The names the YAML uses, in enum order.
+inline constexpr const char* kSelectionPolicyNames[] = {"criterion", "first", "random",
+                                                        "least_informative", "determinant"};
+
+/// The enum of a `slam.ekf.motion_integration` value. Throws ParamError for
+/// a name not in kMotionIntegrationNames.
+MotionIntegration MotionIntegrationFromName(const std::string& name);
+/// The enum of a `slam.ekf.selection_policy` value. Throws ParamError for a
+/// name not in kSelectionPolicyNames.
+SelectionPolicy SelectionPolicyFromName(const std::string& name);
+
 /// Noise of the commanded velocities as the filter's input (`input:
 /// command`). The robot's real motion differs from the command through the
 /// wheel dynamics (lag, acceleration limits, slip), so these must cover that
@@ -88,6 +126,10 @@ struct EkfParams {
   /// over dt, as in the paper) or "odometry" (the wheel-odometry increment
   /// between consecutive records, turned into the equivalent input).
   std::string input = "command";
+  /// How Eq. (6) is integrated over a step: "exact" (the axle centre on an
+  /// arc, docs/method.md departure 9) or "euler" (the paper's forward-Euler
+  /// step). Read as MotionIntegration.
+  std::string motion_integration = "exact";
   /// Offset `a` of the point of control h (frame R) ahead of the wheel axle,
   /// metres (> 0). Must match the robot's (`robot.control_point_offset_m`).
   double control_point_offset_m = 0.2;
@@ -153,10 +195,15 @@ struct EkfParams {
   /// MAX of the paper's Algorithm 2: the most features used per correction by
   /// the selective filter (>= 1). Ignored by the classical filter.
   int max_updates = 2;
+  /// How the selective filter chooses its max_updates observations:
+  /// "criterion" (the paper's), "first", "random", "least_informative" or
+  /// "determinant" (SelectionPolicy). Ignored by the classical filter.
+  std::string selection_policy = "criterion";
 
   template <typename Archive>
   void Serialize(Archive* a) {
     a->Visit(MJSLAM_NVP(input));
+    a->Visit(MJSLAM_NVP(motion_integration));
     a->Visit(MJSLAM_NVP(control_point_offset_m));
     a->Visit(MJSLAM_NVP(command_noise));
     a->Visit(MJSLAM_NVP(odometry_noise));
@@ -173,6 +220,7 @@ struct EkfParams {
     a->Visit(MJSLAM_NVP(correct_corners_of_matched_lines));
     a->Visit(MJSLAM_NVP(corners_from_map_lines));
     a->Visit(MJSLAM_NVP(max_updates));
+    a->Visit(MJSLAM_NVP(selection_policy));
   }
   /// Every out-of-range field, keys relative to this struct (nested ones as
   /// `command_noise.v_noise_std_mps`, ...).

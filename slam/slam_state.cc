@@ -47,7 +47,8 @@ Eigen::Matrix<double, 5, 5> SlamState::JointCovariance(int k) const {
 void SlamState::Predict(const MotionInput& input, double a_m) {
   Eigen::Matrix3d A;
   Eigen::Matrix<double, 3, 2> W;
-  x_.head<3>() = PredictPose(x_.head<3>(), input.increment, a_m, &A, &W, input.skid_per_m_rad);
+  x_.head<3>() = PredictPose(x_.head<3>(), input.increment, a_m, &A, &W, input.skid_per_m_rad,
+                             input.integration);
 
   // Pose block: A P_pp A^T + W Q W^T, symmetrised exactly.
   const Eigen::Matrix3d P_pp = P_.topLeftCorner<3, 3>();

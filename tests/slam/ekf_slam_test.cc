@@ -74,6 +74,62 @@ TEST(EkfParamsTest, DefaultsAreValidAndBadValuesAreNamed) {
   EXPECT_THROW(params.ValidateOrThrow(), ParamError);
 }
 
+TEST(EkfParamsTest, MotionIntegrationAndSelectionPolicyAreNamedChoices) {
+  EkfParams params;
+  EXPECT_EQ(params.motion_integration, "exact");  // today's behaviour
+  EXPECT_EQ(params.selection_policy, "criterion");  // the paper's
+  EXPECT_EQ(MotionIntegrationFromName("exact"), MotionIntegration::kExact);
+  EXPECT_EQ(MotionIntegrationFromName("euler"), MotionIntegration::kEuler);
+  EXPECT_EQ(SelectionPolicyFromName("criterion"), SelectionPolicy::kCriterion);
+  EXPECT_EQ(SelectionPolicyFromName("first"), SelectionPolicy::kFirst);
+  EXPECT_EQ(SelectionPolicyFromName("random"), SelectionPolicy::kRandom);
+  EXPECT_EQ(SelectionPolicyFromName("least_informative"), SelectionPolicy::kLeastInformative);
+  EXPECT_EQ(SelectionPolicyFromName("determinant"), SelectionPolicy::kDeterminant);
+  EXPECT_THROW(MotionIntegrationFromName("rk4"), ParamError);
+  EXPECT_THROW(SelectionPolicyFromName("best"), ParamError);
+  params.motion_integration = "rk4";
+  params.selection_policy = "best";
+  std::string keys;
+  for (const ParamProblem& problem : params.Validate()) keys += problem.key + " ";
+  EXPECT_NE(keys.find("motion_integration"), std::string::npos) << keys;
+  EXPECT_NE(keys.find("selection_policy"), std::string::npos) << keys;
+  params.motion_integration = "euler";
+  params.selection_policy = "least_informative";
+  EXPECT_TRUE(params.Validate().empty());
+}
+
+TEST(EkfSlamTest, MotionIntegrationKeyChoosesThePrediction) {
+  // A turning command: the filter's pose is PredictPose's of the chosen
+  // integration, and the two differ.
+  SensorRecord record;
+  record.dt_s = 0.1;
+  record.command = Twist2{0.5, 1.2};
+  const Pose2 start(1.0, 2.0, 0.3);
+  const Eigen::Vector2d increment(0.05, 0.12);
+  for (const MotionIntegration integration :
+       {MotionIntegration::kExact, MotionIntegration::kEuler}) {
+    EkfParams params;
+    params.lateral_skid_s = 0.0;
+    params.motion_integration = integration == MotionIntegration::kEuler ? "euler" : "exact";
+    EkfSlam filter(params, CorrectionMode::kSelective, start, Pose2());
+    filter.Step(record, nullptr);
+    const Eigen::Vector3d expected =
+        PredictPose(Eigen::Vector3d(start.x, start.y, start.theta), increment,
+                    params.control_point_offset_m, nullptr, nullptr, 0.0, integration);
+    EXPECT_NEAR(filter.X_WR().x, expected.x(), 1e-12);
+    EXPECT_NEAR(filter.X_WR().y, expected.y(), 1e-12);
+    EXPECT_NEAR(filter.X_WR().theta, expected.z(), 1e-12);
+  }
+  EkfParams exact;
+  EkfParams euler;
+  euler.motion_integration = "euler";
+  EkfSlam a(exact, CorrectionMode::kClassical, start, Pose2());
+  EkfSlam b(euler, CorrectionMode::kClassical, start, Pose2());
+  a.Step(record, nullptr);
+  b.Step(record, nullptr);
+  EXPECT_GT(std::abs(a.X_WR().y - b.X_WR().y) + std::abs(a.X_WR().x - b.X_WR().x), 1e-4);
+}
+
 TEST(SlamParamsTest, MergesBothPartsWithPrefixes) {
   SlamParams params;
   EXPECT_TRUE(params.Validate().empty());

@@ -300,24 +300,69 @@ TEST(MotionModelTest, SkidMovesROutwardAcrossTheMidArcHeading) {
             PredictPose(pose, Eigen::Vector2d(0.0, 0.1), 0.2));
 }
 
+TEST(MotionModelTest, EulerIsThePapersEquationSixWithTheStartHeading) {
+  // Heading pi/2, d = 0.3, dth = 0.1, a = 0.2: x' = x + d cos th - a dth sin th
+  // = 1 - 0.02, y' = y + d sin th + a dth cos th = 2.3, th' = th + 0.1.
+  const Eigen::Vector3d pose(1.0, 2.0, kPi / 2.0);
+  const Eigen::Vector2d increment(0.3, 0.1);
+  const Eigen::Vector3d euler =
+      PredictPose(pose, increment, 0.2, nullptr, nullptr, 0.0, MotionIntegration::kEuler);
+  EXPECT_NEAR(euler.x(), 1.0 - 0.02, 1e-12);
+  EXPECT_NEAR(euler.y(), 2.3, 1e-12);
+  EXPECT_NEAR(euler.z(), kPi / 2.0 + 0.1, 1e-12);
+  // The exact arc ends elsewhere in a turn (by about d dth / 2 sideways)...
+  const Eigen::Vector3d exact = PredictPose(pose, increment, 0.2);
+  EXPECT_GT((exact - euler).head<2>().norm(), 0.01);
+  // ... and at the same place without a turn.
+  const Eigen::Vector2d straight(0.3, 0.0);
+  EXPECT_LT((PredictPose(pose, straight, 0.2, nullptr, nullptr, 0.0, MotionIntegration::kEuler) -
+             PredictPose(pose, straight, 0.2))
+                .norm(),
+            1e-15);
+  // The skid moves R outward across the start heading: heading pi/2, left
+  // turn, so +x by skid d dth.
+  const Eigen::Vector3d skidded =
+      PredictPose(pose, increment, 0.2, nullptr, nullptr, 0.05, MotionIntegration::kEuler);
+  EXPECT_NEAR(skidded.x() - euler.x(), 0.05 * 0.3 * 0.1, 1e-15);
+  EXPECT_NEAR(skidded.y(), euler.y(), 1e-15);
+}
+
 TEST(MotionModelTest, JacobiansAAndWMatchCentralDifferences) {
-  Rng rng(16);
-  for (int trial = 0; trial < 100; ++trial) {
-    const Eigen::Vector3d pose = RandomPose(&rng);
-    const Eigen::Vector2d increment(rng.Gaussian(0.0, 0.5), rng.Gaussian(0.0, 0.5));
-    const double a = 0.05 + 0.3 * rng.Uniform();
-    const double skid = trial % 2 == 0 ? 0.0 : 0.2 * rng.Uniform();  // with and without
-    Eigen::Matrix3d A;
-    Eigen::Matrix<double, 3, 2> W;
-    PredictPose(pose, increment, a, &A, &W, skid);
-    const Eigen::Matrix3d numerical_A = NumericalJacobian<3, 3>(
-        [&](const Eigen::Vector3d& p) { return PredictPose(p, increment, a, nullptr, nullptr, skid); },
-        pose, {2});
-    const Eigen::Matrix<double, 3, 2> numerical_W = NumericalJacobian<3, 2>(
-        [&](const Eigen::Vector2d& u) { return PredictPose(pose, u, a, nullptr, nullptr, skid); },
-        increment, {2});
-    EXPECT_LT((A - numerical_A).cwiseAbs().maxCoeff(), kJacobianTolerance) << "trial " << trial;
-    EXPECT_LT((W - numerical_W).cwiseAbs().maxCoeff(), kJacobianTolerance) << "trial " << trial;
+  // Both integrations, each with its own A and W.
+  for (const MotionIntegration integration :
+       {MotionIntegration::kExact, MotionIntegration::kEuler}) {
+    SCOPED_TRACE(integration == MotionIntegration::kEuler ? "euler" : "exact");
+    Rng rng(16);
+    for (int trial = 0; trial < 100; ++trial) {
+      const Eigen::Vector3d pose = RandomPose(&rng);
+      const Eigen::Vector2d increment(rng.Gaussian(0.0, 0.5), rng.Gaussian(0.0, 0.5));
+      const double a = 0.05 + 0.3 * rng.Uniform();
+      const double skid = trial % 2 == 0 ? 0.0 : 0.2 * rng.Uniform();  // with and without
+      Eigen::Matrix3d A;
+      Eigen::Matrix<double, 3, 2> W;
+      PredictPose(pose, increment, a, &A, &W, skid, integration);
+      const Eigen::Matrix3d numerical_A = NumericalJacobian<3, 3>(
+          [&](const Eigen::Vector3d& p) {
+            return PredictPose(p, increment, a, nullptr, nullptr, skid, integration);
+          },
+          pose, {2});
+      const Eigen::Matrix<double, 3, 2> numerical_W = NumericalJacobian<3, 2>(
+          [&](const Eigen::Vector2d& u) {
+            return PredictPose(pose, u, a, nullptr, nullptr, skid, integration);
+          },
+          increment, {2});
+      EXPECT_LT((A - numerical_A).cwiseAbs().maxCoeff(), kJacobianTolerance) << "trial " << trial;
+      EXPECT_LT((W - numerical_W).cwiseAbs().maxCoeff(), kJacobianTolerance) << "trial " << trial;
+      // The two models' W differ in a turn: each test checks its own.
+      const MotionIntegration other = integration == MotionIntegration::kEuler
+                                          ? MotionIntegration::kExact
+                                          : MotionIntegration::kEuler;
+      Eigen::Matrix<double, 3, 2> W_other;
+      PredictPose(pose, increment, a, nullptr, &W_other, skid, other);
+      if (std::abs(increment.y()) > 0.1) {
+        EXPECT_GT((W - W_other).cwiseAbs().maxCoeff(), 1e-3) << "trial " << trial;
+      }
+    }
   }
 }
 

@@ -233,5 +233,127 @@ TEST(SelectionTest, SelectiveUsesMinOfMatchedAndMax) {
   EXPECT_EQ(CorrectClassical(&c, matched), 3);
 }
 
+// A hand-made selection problem whose answer is known. The pose is uncertain
+// (x, y, th all, full rank); two corners are independent of it and of each
+// other: corner A, 2 m ahead, barely known (1 m std), and corner B, 2 m to
+// the left, almost exactly known. Candidates, in extraction order:
+//   0: A with R = 1e-3 I   (informative by the criterion, no pose gain)
+//   1: B with R = 1e-1 I   (little information: S is dominated by R)
+//   2: A with R = 1e-4 I   (the smallest trace(S^-1 R): the criterion's pick)
+//   3: B with R = 1e-2 I   (pins the pose: the smallest det of P_pp after)
+// A's innovation is explained by A's own uncertainty, so observing it
+// precisely lowers 3 + tr(S^-1 R) but leaves the pose as it was; B's
+// corrects the pose.
+struct KnownProblem {
+  SlamState state;
+  std::vector<MatchedObservation> matched;
+};
+
+KnownProblem MakeKnownProblem() {
+  SlamState state(Eigen::Vector3d::Zero(), Eigen::Matrix3d::Zero(), Pose2());
+  const int a = state.AddFeature(FeatureType::kCorner, Eigen::Vector2d(2.0, 0.0),
+                                 Eigen::Vector2d(1.0, 0.25).asDiagonal());
+  const int b = state.AddFeature(FeatureType::kCorner, Eigen::Vector2d(2.0, kPi / 2.0),
+                                 Eigen::Vector2d(1e-8, 1e-8).asDiagonal());
+  MotionInput input;  // no motion, but the pose becomes uncertain
+  input.covariance = Eigen::Vector2d(0.01, 0.01).asDiagonal();
+  input.lateral_variance_m2 = 0.01;
+  state.Predict(input, 0.2);
+  KnownProblem problem{state, {}};
+  const Eigen::Matrix2d I = Eigen::Matrix2d::Identity();
+  auto observe = [&](int k, double r) {
+    problem.matched.push_back({k, state.Measure(k).h + Eigen::Vector2d(0.01, 0.005), r * I});
+  };
+  observe(a, 1e-3);
+  observe(b, 1e-1);
+  observe(a, 1e-4);
+  observe(b, 1e-2);
+  return problem;
+}
+
+// The index chosen with MAX = 1 under `policy`.
+int ChosenAlone(SelectionPolicy policy, Rng* rng = nullptr) {
+  KnownProblem problem = MakeKnownProblem();
+  const std::vector<int> used =
+      CorrectSelective(&problem.state, problem.matched, 1, policy, rng);
+  EXPECT_EQ(used.size(), 1u);
+  return used.empty() ? -1 : used[0];
+}
+
+TEST(SelectionPolicyTest, TheKnownProblemIsAsDesigned) {
+  // The premises of the expected answers below, so that a change of the
+  // problem cannot make the policy tests pass by accident.
+  const KnownProblem problem = MakeKnownProblem();
+  EXPECT_GT(problem.state.pose_covariance().determinant(), 0.0);
+  std::vector<double> criterion, determinant;
+  for (const MatchedObservation& candidate : problem.matched) {
+    criterion.push_back(SelectionCriterion(problem.state, candidate));
+    determinant.push_back(PoseDeterminantAfter(problem.state, candidate));
+  }
+  auto argmin = [](const std::vector<double>& v) {
+    return static_cast<int>(std::min_element(v.begin(), v.end()) - v.begin());
+  };
+  auto argmax = [](const std::vector<double>& v) {
+    return static_cast<int>(std::max_element(v.begin(), v.end()) - v.begin());
+  };
+  EXPECT_EQ(argmin(criterion), 2);
+  EXPECT_EQ(argmax(criterion), 1);
+  EXPECT_EQ(argmin(determinant), 3);
+  // A's observations hardly move the pose's determinant; B's shrink it.
+  const double before = problem.state.pose_covariance().determinant();
+  EXPECT_GT(determinant[2], 0.9 * before);
+  EXPECT_LT(determinant[3], 0.5 * before);
+}
+
+TEST(SelectionPolicyTest, EachPolicyPicksItsKnownCandidate) {
+  EXPECT_EQ(ChosenAlone(SelectionPolicy::kCriterion), 2);
+  EXPECT_EQ(ChosenAlone(SelectionPolicy::kFirst), 0);
+  EXPECT_EQ(ChosenAlone(SelectionPolicy::kLeastInformative), 1);
+  EXPECT_EQ(ChosenAlone(SelectionPolicy::kDeterminant), 3);
+  // With MAX = 2: first takes the first two in extraction order.
+  KnownProblem problem = MakeKnownProblem();
+  EXPECT_EQ(CorrectSelective(&problem.state, problem.matched, 2, SelectionPolicy::kFirst),
+            (std::vector<int>{0, 1}));
+}
+
+TEST(SelectionPolicyTest, DeterminantIsTheBruteForceDeterminantAfterTheUpdate) {
+  // PoseDeterminantAfter against applying the update and measuring det P_pp.
+  Rng rng(35);
+  for (int trial = 0; trial < 50; ++trial) {
+    const SlamState state = MakeState(&rng, 6);
+    for (const MatchedObservation& candidate : MakeMatched(&rng, state, 6)) {
+      SlamState updated = state;
+      updated.Update(candidate.feature, candidate.z, candidate.R);
+      const double expected = updated.pose_covariance().determinant();
+      EXPECT_NEAR(PoseDeterminantAfter(state, candidate), expected, 1e-9 * std::abs(expected))
+          << "trial " << trial;
+    }
+  }
+}
+
+TEST(SelectionPolicyTest, RandomIsUniformWithoutRepeatsAndDeterministicBySeed) {
+  // Same stream, same choice; the choice is the stream's first draw.
+  Rng expected_rng(7);
+  const int expected = static_cast<int>(expected_rng.Uniform() * 4);
+  Rng a(7), b(7);
+  EXPECT_EQ(ChosenAlone(SelectionPolicy::kRandom, &a), expected);
+  EXPECT_EQ(ChosenAlone(SelectionPolicy::kRandom, &b), expected);
+  // Every candidate about a quarter of the time over 2000 draws of one
+  // stream (binomial std 1 %: bounds at 5 sigma).
+  Rng rng(8);
+  std::vector<int> counts(4, 0);
+  for (int draw = 0; draw < 2000; ++draw) ++counts[ChosenAlone(SelectionPolicy::kRandom, &rng)];
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_GT(counts[i], 400) << "candidate " << i;
+    EXPECT_LT(counts[i], 600) << "candidate " << i;
+  }
+  // MAX = 4: a permutation, each candidate once.
+  KnownProblem problem = MakeKnownProblem();
+  std::vector<int> used =
+      CorrectSelective(&problem.state, problem.matched, 4, SelectionPolicy::kRandom, &rng);
+  std::sort(used.begin(), used.end());
+  EXPECT_EQ(used, (std::vector<int>{0, 1, 2, 3}));
+}
+
 }  // namespace
 }  // namespace mjslam::slam
