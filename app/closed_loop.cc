@@ -73,7 +73,7 @@ ClosedLoop::ClosedLoop(const RunConfig& config)
     if (waypoints.empty()) waypoints = w.simulator.scene().TourWaypoints();
     w.tour.emplace(config_.driver, waypoints, a_m);
   }
-  slam_.emplace(config_.slam, config_.control, dt_s_, X_WR0_, X_RS_);
+  slam_.emplace(config_.slam, config_.control, dt_s_, X_WR0_, X_RS_, Rng(config_.run.seed));
   w.coverage.emplace(w.simulator.scene().Obstacles(), (X_WR0_ * Pose2(-a_m, 0.0, 0.0)).translation());
   last_step_ = static_cast<int>(
       std::floor(config_.run.duration_s * config_.run.control_rate_hz + 1e-9));
@@ -84,7 +84,7 @@ ClosedLoop::ClosedLoop(const RunConfig& config, const rundir::Recording& recordi
   const Pose2& X_WR0 = recording.Step(0).X_WR_true;
   X_WR0_ = Pose2(X_WR0.x, X_WR0.y, X_WR0.theta);
   X_RS_ = recording.X_RS();
-  slam_.emplace(config_.slam, config_.control, dt_s_, X_WR0_, X_RS_);
+  slam_.emplace(config_.slam, config_.control, dt_s_, X_WR0_, X_RS_, Rng(config_.run.seed));
   last_step_ = static_cast<int>(recording.num_steps()) - 1;
 }
 

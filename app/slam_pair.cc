@@ -28,15 +28,19 @@ FilterTiming FilterTimingFromText(const std::string& text) {
 }
 
 SlamPair::SlamPair(const slam::SlamParams& params, const ControlParams& control, double dt_s,
-                   const Pose2& X_WR0, const Pose2& X_RS)
+                   const Pose2& X_WR0, const Pose2& X_RS, const Rng& run_rng)
     : params_(params),
       control_(control),
       dt_s_(dt_s),
       timing_(FilterTimingFromText(params.timing)) {
   filters_.emplace_back(
-      "classical", slam::EkfSlam(params.ekf, slam::CorrectionMode::kClassical, X_WR0, X_RS));
+      "classical", slam::EkfSlam(params.ekf, slam::CorrectionMode::kClassical, X_WR0, X_RS,
+                                 run_rng.Fork("slam.classical.selection")));
+  // The selective filter's draws (slam.ekf.selection_policy: random) are a
+  // stream of their own, forked from the run seed by name.
   filters_.emplace_back(
-      "selective", slam::EkfSlam(params.ekf, slam::CorrectionMode::kSelective, X_WR0, X_RS));
+      "selective", slam::EkfSlam(params.ekf, slam::CorrectionMode::kSelective, X_WR0, X_RS,
+                                 run_rng.Fork("slam.selective.selection")));
 }
 
 void SlamPair::Step(const SensorRecord& record) {

@@ -6,6 +6,7 @@
 
 #include "app/control.h"
 #include "common/records.h"
+#include "common/rng.h"
 #include "eval/map_types.h"
 #include "rundir/rows.h"
 #include "slam/ekf_slam.h"
@@ -39,9 +40,11 @@ FilterTiming FilterTimingFromText(const std::string& text);
 class SlamPair {
  public:
   /// X_WR0: known initial pose of R; X_RS: the laser mount on R; `dt_s` the
-  /// control period without delay (one control step).
+  /// control period without delay (one control step); `run_rng` the run
+  /// seed's stream, from which each filter forks its own draws by name (the
+  /// random selection policy).
   SlamPair(const slam::SlamParams& params, const ControlParams& control, double dt_s,
-           const Pose2& X_WR0, const Pose2& X_RS);
+           const Pose2& X_WR0, const Pose2& X_RS, const Rng& run_rng);
 
   /// Runs both filters on one record, the record of the next control step
   /// (the first call is step 0). In realtime timing, a filter still busy

@@ -83,7 +83,7 @@ TEST(SlamPairTest, RealtimeFilterBusyForKStepsSkipsExactlyThoseScans) {
   const std::vector<SensorRecord> records = StraightRecords(std::vector<double>(20, 0.3));
   for (const int k : {1, 2, 3, 5}) {
     SlamPair pair(Timing("realtime", "command"), ModelCost(kDt * (k - 1) + 0.05), kDt,
-                  Pose2(), Pose2());
+                  Pose2(), Pose2(), Rng(1));
     int processed = 0;
     for (int s = 0; s < static_cast<int>(records.size()); ++s) {
       pair.Step(records[s]);
@@ -104,7 +104,7 @@ TEST(SlamPairTest, RealtimeFilterBusyForKStepsSkipsExactlyThoseScans) {
 // period.
 TEST(SlamPairTest, EveryScanTimingProcessesEveryScan) {
   const std::vector<SensorRecord> records = StraightRecords(std::vector<double>(10, 0.3));
-  SlamPair pair(Timing("every_scan", "command"), ModelCost(0.25), kDt, Pose2(), Pose2());
+  SlamPair pair(Timing("every_scan", "command"), ModelCost(0.25), kDt, Pose2(), Pose2(), Rng(1));
   for (const SensorRecord& record : records) {
     pair.Step(record);
     EXPECT_TRUE(pair.processed(0));
@@ -118,7 +118,7 @@ TEST(SlamPairTest, EveryScanTimingProcessesEveryScan) {
 // A skipped step's row holds the last processed estimate and says so.
 TEST(SlamPairTest, SkippedStepReportsTheLastProcessedEstimate) {
   const std::vector<SensorRecord> records = StraightRecords(std::vector<double>(4, 0.5));
-  SlamPair pair(Timing("realtime", "command"), ModelCost(0.25), kDt, Pose2(), Pose2());
+  SlamPair pair(Timing("realtime", "command"), ModelCost(0.25), kDt, Pose2(), Pose2(), Rng(1));
   pair.Step(records[0]);
   const std::vector<rundir::FilterRow> first = pair.Rows(Pose2());
   pair.Step(records[1]);
@@ -140,8 +140,8 @@ TEST(SlamPairTest, SkippedStepReportsTheLastProcessedEstimate) {
 TEST(SlamPairTest, RealtimePredictionIntegratesEveryCommandOfTheSkippedSteps) {
   const std::vector<double> v = {0.0, 0.1, 0.2, 0.4, 0.3, 0.5, 0.1, 0.2, 0.3, 0.6, 0.2};
   const std::vector<SensorRecord> records = StraightRecords(v);
-  SlamPair realtime(Timing("realtime", "command"), ModelCost(0.25), kDt, Pose2(), Pose2());
-  SlamPair every_scan(Timing("every_scan", "command"), ModelCost(0.25), kDt, Pose2(), Pose2());
+  SlamPair realtime(Timing("realtime", "command"), ModelCost(0.25), kDt, Pose2(), Pose2(), Rng(1));
+  SlamPair every_scan(Timing("every_scan", "command"), ModelCost(0.25), kDt, Pose2(), Pose2(), Rng(1));
   double x = 0.0;
   double x_processed = 0.0;
   for (int s = 0; s < static_cast<int>(records.size()); ++s) {
@@ -171,7 +171,7 @@ TEST(SlamPairTest, RealtimePredictionIntegratesEveryCommandOfTheSkippedSteps) {
 TEST(SlamPairTest, RealtimePredictionTakesTheOdometryOfTheSkippedSteps) {
   const std::vector<double> v(13, 0.5);
   const std::vector<SensorRecord> records = StraightRecords(v);
-  SlamPair realtime(Timing("realtime", "odometry"), ModelCost(0.35), kDt, Pose2(), Pose2());
+  SlamPair realtime(Timing("realtime", "odometry"), ModelCost(0.35), kDt, Pose2(), Pose2(), Rng(1));
   for (int s = 0; s < static_cast<int>(records.size()); ++s) {
     realtime.Step(records[s]);
     const double expected = s % 4 == 0 ? s * kDt * 0.5 : (s / 4) * 4 * kDt * 0.5;
@@ -196,7 +196,7 @@ TEST(SlamPairTest, RealtimeOdometryPredictionUsesTheWholeElapsedTime) {
   }
   slam::SlamParams params = Timing("realtime", "odometry");
   ASSERT_GT(params.ekf.lateral_skid_s, 0.0);
-  SlamPair realtime(params, ModelCost(0.35), kDt, Pose2(), Pose2());
+  SlamPair realtime(params, ModelCost(0.35), kDt, Pose2(), Pose2(), Rng(1));
   for (const SensorRecord& record : records) realtime.Step(record);
   ASSERT_TRUE(realtime.processed(0));
 
