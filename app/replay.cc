@@ -21,7 +21,7 @@ void Replay(const RunConfig& config, const ReplayOptions& options) {
   const rundir::Recording recording(options.scans_path, options.trajectory_path,
                                     config.laser.num_beams);
   const std::string& dir = options.out_dir;
-  rundir::MakeRunDirectory(dir);
+  const rundir::RunDirectoryLock lock(dir);
   rundir::WriteFileAtomically(rundir::PathIn(dir, rundir::kConfigFile), config::ToYaml(config));
   rundir::ManifestWriter manifest(dir, {{"mode", "replay"},
                                         {"scans_file", options.scans_path},

@@ -98,7 +98,7 @@ std::optional<std::string> RangeNoiseNote(const RunConfig& config) {
 RunResult RunSimulation(const RunConfig& config, const RunOptions& options) {
   config.ValidateOrThrow();
   const std::string& dir = options.out_dir;
-  rundir::MakeRunDirectory(dir);
+  const rundir::RunDirectoryLock lock(dir);
   rundir::WriteFileAtomically(rundir::PathIn(dir, rundir::kConfigFile), config::ToYaml(config));
   rundir::ManifestWriter manifest(dir, StartManifest(config, options));
   RunResult result;

@@ -233,6 +233,8 @@ SweepResult RunSweep(const RunConfig& config, const SweepOptions& options) {
   config.ValidateOrThrow();
   const int jobs = CheckedJobs(options);
   const std::string& dir = options.out_dir;
+  // A resume while the sweep still runs would start its runs beside it.
+  const rundir::RunDirectoryLock lock(dir);
   const std::string config_path = PrepareSweepDirectory(config, dir);
   std::vector<std::string> run_dirs;
   for (int i = 0; i < options.runs; ++i) {

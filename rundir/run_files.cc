@@ -1,6 +1,7 @@
 #include "rundir/run_files.h"
 
 #include <fcntl.h>
+#include <sys/file.h>
 #include <unistd.h>
 
 #include <cerrno>
@@ -87,6 +88,26 @@ void MakeRunDirectory(const std::string& dir) {
     throw std::runtime_error(dir + ": cannot create the run directory" +
                              (error ? ": " + error.message() : std::string()));
   }
+}
+
+RunDirectoryLock::RunDirectoryLock(const std::string& dir) {
+  MakeRunDirectory(dir);
+  fd_ = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd_ < 0) throw std::runtime_error(dir + ": cannot open the run directory: " + std::strerror(errno));
+  if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+    const int error = errno;
+    ::close(fd_);
+    fd_ = -1;
+    if (error == EWOULDBLOCK) {
+      throw std::runtime_error(dir + ": in use by another mjslam process (a run, replay or sweep "
+                               "writing there); wait for it to end or use another --out");
+    }
+    throw std::runtime_error(dir + ": cannot lock the run directory: " + std::strerror(error));
+  }
+}
+
+RunDirectoryLock::~RunDirectoryLock() {
+  if (fd_ >= 0) ::close(fd_);
 }
 
 }  // namespace mjslam::rundir

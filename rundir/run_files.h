@@ -27,4 +27,22 @@ std::string UtcNow();
 /// cannot, or if it exists and is not a folder.
 void MakeRunDirectory(const std::string& dir);
 
+/// A run (or replay, or sweep) directory held by this process: created if
+/// missing (MakeRunDirectory), then locked with an exclusive flock on the
+/// folder itself (no lock file is left behind) until the object is
+/// destroyed or the process ends, however it ends. Child processes do not
+/// inherit the lock. Throws std::runtime_error naming the folder when
+/// another process (another `mjslam run` with the same --out, say) holds
+/// it: two writers into one folder would interleave rows and mix files.
+class RunDirectoryLock {
+ public:
+  explicit RunDirectoryLock(const std::string& dir);
+  ~RunDirectoryLock();
+  RunDirectoryLock(const RunDirectoryLock&) = delete;
+  RunDirectoryLock& operator=(const RunDirectoryLock&) = delete;
+
+ private:
+  int fd_ = -1;
+};
+
 }  // namespace mjslam::rundir

@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "rundir/layout.h"
+#include "rundir/run_files.h"
 #include "tests/integration/run_helpers.h"
 
 namespace mjslam::testing {
@@ -222,6 +223,30 @@ TEST(RunFailureTest, BadOverrideNamesTheKeyAndValue) {
   EXPECT_NE(err.find("laser.max_range_m"), std::string::npos) << err;
   EXPECT_NE(err.find("-4"), std::string::npos) << err;
   EXPECT_FALSE(std::filesystem::exists(dir + "/run/trajectory.csv"));
+}
+
+// Two writers into one run directory interleaved rows and mixed files: a
+// directory held by another process is refused before anything is written.
+TEST(RunFailureTest, RunDirectoryInUseIsRefusedAndLeftAlone) {
+  const std::string dir = FreshDir("in_use");
+  const std::string run = dir + "/run";
+  {
+    const rundir::RunDirectoryLock held(run);  // stands for a run still going
+    std::ofstream(rundir::PathIn(run, rundir::kConfigFile)) << "the other run's config\n";
+    const int status = Shell(Program() + " run --quiet --no-render --duration 1 --config " +
+                             DefaultConfig() + " --out " + run + " 2> " + dir + "/err.log");
+    EXPECT_EQ(status, 1);
+    EXPECT_NE(ReadText(dir + "/err.log").find(run + ": in use by another mjslam process"),
+              std::string::npos)
+        << ReadText(dir + "/err.log");
+    EXPECT_EQ(ReadText(rundir::PathIn(run, rundir::kConfigFile)), "the other run's config\n");
+    EXPECT_FALSE(std::filesystem::exists(rundir::PathIn(run, rundir::kTrajectoryFile)));
+  }
+  // Released with its holder: the next run goes ahead.
+  EXPECT_EQ(Shell(Program() + " run --quiet --no-render --duration 1 --config " + DefaultConfig() +
+                  " --out " + run + " 2> " + dir + "/err2.log"),
+            0)
+      << ReadText(dir + "/err2.log");
 }
 
 // A negative seed wrapped to 2^64 - 1 and a huge duration overflowed the
