@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <exception>
 #include <optional>
+#include <utility>
 
 #include "app/closed_loop.h"
 #include "app/live_video.h"
@@ -98,9 +99,12 @@ std::optional<std::string> RangeNoiseNote(const RunConfig& config) {
 RunResult RunSimulation(const RunConfig& config, const RunOptions& options) {
   config.ValidateOrThrow();
   const std::string& dir = options.out_dir;
+  // The manifest reads (hashes) the world and robot files: a missing one is
+  // an error before anything is written.
+  nlohmann::json start_manifest = StartManifest(config, options);
   const rundir::RunDirectoryLock lock(dir);
   rundir::WriteFileAtomically(rundir::PathIn(dir, rundir::kConfigFile), config::ToYaml(config));
-  rundir::ManifestWriter manifest(dir, StartManifest(config, options));
+  rundir::ManifestWriter manifest(dir, std::move(start_manifest));
   RunResult result;
   result.status = "completed";
   auto record_progress = [&]() {

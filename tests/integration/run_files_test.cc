@@ -211,6 +211,9 @@ TEST(RunFailureTest, MissingWorldIsAClearErrorAndNoRunIsStarted) {
   EXPECT_EQ(status, 1);
   EXPECT_NE(ReadText(dir + "/err.log").find("/no/such/world.xml"), std::string::npos)
       << ReadText(dir + "/err.log");
+  // Nothing written: a folder with a config.yaml and no manifest looked like
+  // a run that never said how it ended.
+  EXPECT_FALSE(std::filesystem::exists(dir + "/run"));
 }
 
 TEST(RunFailureTest, BadOverrideNamesTheKeyAndValue) {
