@@ -17,6 +17,7 @@
 #include "app/replay.h"
 #include "app/run.h"
 #include "app/run_config.h"
+#include "app/slurm.h"
 #include "app/sweep.h"
 #include "app/version.h"
 #include "config/config.h"
@@ -214,17 +215,51 @@ struct SweepCommand {
   SweepOptions options;
   double duration_s = 0.0;
   bool quiet = false;
+  std::string campaign_path;
+  std::vector<std::string> worlds;
+  std::vector<std::string> vary;
+  std::string backend = "local";
+  bool no_wait = false;
+  std::string aggregate_dir;
 };
+
+// The sweep's Slurm options (docs/commands.md, "Slurm backend").
+void AddSlurmOptions(CLI::App* sweep, SweepCommand* c) {
+  SlurmOptions& slurm = c->options.slurm;
+  sweep->add_option("--backend", c->backend, "Where the runs run: local (processes here) or slurm "
+                    "(one job array)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"local", "slurm"}));
+  sweep->add_option("--max-running", slurm.max_running,
+                    "slurm: array tasks running at once (--array=...%N; 0: no limit)")
+      ->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  sweep->add_option("--partition", slurm.partition, "slurm: partition (sbatch --partition)");
+  sweep->add_option("--time", slurm.time_limit, "slurm: time limit of each array task (sbatch --time)");
+  sweep->add_option("--mem", slurm.memory, "slurm: memory of each array task (sbatch --mem, e.g. 2G)");
+  sweep->add_option("--sbatch-option", slurm.extra_options,
+                    "slurm: any other sbatch option, one per use (e.g. --sbatch-option=--account=lab)");
+  sweep->add_option("--runs-per-task", slurm.runs_per_task, "slurm: runs per array task")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  sweep->add_option("--poll", slurm.poll_s, "slurm: seconds between two looks at the queue")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  sweep->add_flag("--no-wait", c->no_wait,
+                  "slurm: return once submitted; `mjslam sweep --aggregate DIR` finishes");
+}
 
 CLI::App* AddSweep(CLI::App* cli, SweepCommand* c) {
   CLI::App* sweep = cli->add_subcommand(
-      "sweep", "Monte Carlo runs with seeds run.seed + i, evaluated and aggregated");
+      "sweep", "Monte Carlo runs with seeds run.seed + i, evaluated and aggregated; a campaign "
+               "of such sweeps over worlds and config values; locally or on Slurm");
   AddConfigOptions(sweep, &c->config, "Override any config key");
-  sweep->add_option("--runs", c->options.runs, "Number of runs")->required()->check(CLI::PositiveNumber);
-  sweep->add_option("--jobs", c->options.jobs, "Runs at a time (0: one per core)")
+  sweep->add_option("--runs", c->options.runs, "Number of runs (per cell of a campaign)")
+      ->check(CLI::PositiveNumber);
+  sweep->add_option("--jobs", c->options.jobs, "local: runs at a time (0: one per core)")
       ->capture_default_str()
       ->check(NonNegativeInteger());
-  sweep->add_option("--out", c->options.out_dir, "Sweep directory")->required();
+  sweep->add_option("--out", c->options.out_dir, "Sweep directory");
   sweep->add_option("--duration", c->duration_s, "Simulated seconds of each run (overrides run.duration_s)");
   sweep->add_option("--divergence-points", c->options.divergence_points,
                     "Map divergence points of each run's evaluation (0: none)")
@@ -235,23 +270,23 @@ CLI::App* AddSweep(CLI::App* cli, SweepCommand* c) {
                     "Realisations per #E of --divergence-study")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
+  sweep->add_option("--campaign", c->campaign_path,
+                    "Campaign file (YAML: runs, worlds, axes): one sweep per cell of the grid");
+  sweep->add_option("--world", c->worlds, "A campaign over these worlds (repeat the option)");
+  sweep->add_option("--vary", c->vary,
+                    "A campaign axis: KEY=V1,V2,... (repeat the option for more axes)");
+  sweep->add_option("--aggregate", c->aggregate_dir,
+                    "Only finish the sweep in DIR: wait for its Slurm job, then aggregate");
+  AddSlurmOptions(sweep, c);
   sweep->add_flag("--quiet", c->quiet, "No line per finished run");
   return sweep;
 }
 
-int SweepMain(const CLI::App& sweep, SweepCommand c) {
-  if (sweep.count("--duration") > 0) {
-    c.config.overrides.push_back("run.duration_s=" + ValueText(c.duration_s));
-  }
-  const RunConfig config = LoadRunConfig(c.config.path, c.config.overrides);
-  c.options.program = std::filesystem::read_symlink("/proc/self/exe").string();
-  c.options.verbose = !c.quiet;
-  c.options.stop_requested = &g_stop_requested;
-  const SweepResult result = RunSweep(config, c.options);
-  if (result.interrupted) {
-    std::fprintf(stderr, "%s: interrupted; run the same command again to resume\n",
-                 c.options.out_dir.c_str());
-    return 130;
+// What a finished sweep prints: a campaign's table, or each filter's verdict.
+void PrintSweep(const SweepResult& result) {
+  if (!result.table.empty()) {
+    std::fputs(result.table.c_str(), stdout);
+    return;
   }
   for (const std::string& name : rundir::FilterNames()) {
     const auto& f = result.summary["filters"][name];
@@ -262,9 +297,80 @@ int SweepMain(const CLI::App& sweep, SweepCommand c) {
                 f["mean_anees"].is_number() ? f["mean_anees"].get<double>() : 0.0,
                 f["verdict"].get<std::string>().c_str());
   }
-  std::fprintf(stderr, "%s: %d runs made, %d kept\n", c.options.out_dir.c_str(), result.runs_made,
-               result.runs_kept);
+}
+
+int SweepMain(const CLI::App& sweep, SweepCommand c) {
+  c.options.program = std::filesystem::read_symlink("/proc/self/exe").string();
+  c.options.verbose = !c.quiet;
+  c.options.stop_requested = &g_stop_requested;
+  c.options.backend = c.backend == "slurm" ? SweepBackend::kSlurm : SweepBackend::kLocal;
+  c.options.wait = !c.no_wait;
+  SweepResult result;
+  const bool campaign = !c.campaign_path.empty() || !c.worlds.empty() || !c.vary.empty();
+  if (!c.aggregate_dir.empty()) {
+    result = AggregateSweepDirectory(c.aggregate_dir, c.options);
+    c.options.out_dir = c.aggregate_dir;
+  } else {
+    if (c.options.out_dir.empty()) throw std::runtime_error("sweep: --out DIR is required");
+    if (sweep.count("--duration") > 0) {
+      c.config.overrides.push_back("run.duration_s=" + ValueText(c.duration_s));
+    }
+    if (!c.campaign_path.empty() && (!c.worlds.empty() || !c.vary.empty())) {
+      throw std::runtime_error("sweep: --campaign " + c.campaign_path +
+                               " and --world/--vary: give the grid one way");
+    }
+    const CampaignParams grid = !c.campaign_path.empty() ? LoadCampaign(c.campaign_path)
+                                                         : CampaignFromOptions(c.worlds, c.vary);
+    // --runs is needed unless the campaign file says how many.
+    if (sweep.count("--runs") == 0 && !(campaign && grid.runs > 0)) {
+      throw std::runtime_error("sweep: --runs N is required (or runs: in the campaign file)");
+    }
+    CampaignParams with_runs = grid;
+    if (sweep.count("--runs") > 0) with_runs.runs = c.options.runs;
+    result = campaign ? RunCampaign(with_runs, c.config.path, c.config.overrides, c.options)
+                      : RunSweep(LoadRunConfig(c.config.path, c.config.overrides), c.options);
+  }
+  const std::string& dir = c.options.out_dir;
+  if (result.interrupted) {
+    std::fprintf(stderr, "%s: interrupted; %s\n", dir.c_str(),
+                 result.job_id.empty() ? "run the same command again to resume"
+                                       : ("Slurm job " + result.job_id +
+                                          " goes on; mjslam sweep --aggregate " + dir +
+                                          " finishes the sweep")
+                                             .c_str());
+    return 130;
+  }
+  if (result.submitted) {
+    std::fprintf(stderr, "%s: submitted Slurm job %s; mjslam sweep --aggregate %s finishes the sweep\n",
+                 dir.c_str(), result.job_id.c_str(), dir.c_str());
+    return 0;
+  }
+  PrintSweep(result);
+  std::fprintf(stderr, "%s: %d runs made, %d kept\n", dir.c_str(), result.runs_made, result.runs_kept);
   return 0;
+}
+
+// mjslam sweep-task (the job script of the Slurm backend runs it)
+struct SweepTaskCommand {
+  std::string plan_path;
+  int task = 0;
+};
+
+CLI::App* AddSweepTask(CLI::App* cli, SweepTaskCommand* c) {
+  CLI::App* task = cli->add_subcommand(
+      "sweep-task", "One array task of a Slurm sweep: its share of the runs of a plan.json");
+  task->add_option("PLAN", c->plan_path, "plan.json of the submission")->required();
+  task->add_option("TASK", c->task, "the array task ($SLURM_ARRAY_TASK_ID)")
+      ->required()
+      ->check(CLI::NonNegativeNumber);
+  return task;
+}
+
+int SweepTaskMain(const SweepTaskCommand& c) {
+  const RunPoolResult result = RunSweepTask(c.plan_path, c.task, &g_stop_requested);
+  for (const std::string& failure : result.failures) std::fprintf(stderr, "%s\n", failure.c_str());
+  if (result.interrupted) return 130;
+  return result.failures.empty() ? 0 : 1;
 }
 
 // mjslam divergence
@@ -350,6 +456,7 @@ int main(int argc, char** argv) {
   app::ConfigOptions config;
   app::EvaluateCommand evaluate;
   app::SweepCommand sweep;
+  app::SweepTaskCommand sweep_task;
   app::DivergenceCommand divergence;
   app::RenderCommand render;
   const std::string command_line = app::JoinArguments(argc, argv);
@@ -360,6 +467,7 @@ int main(int argc, char** argv) {
       {app::AddConfig(&cli, &config), [&] { return app::ConfigMain(config); }},
       {app::AddEvaluate(&cli, &evaluate), [&] { return app::EvaluateMain(evaluate); }},
       {app::AddSweep(&cli, &sweep), [&] { return app::SweepMain(*cli.get_subcommand("sweep"), sweep); }},
+      {app::AddSweepTask(&cli, &sweep_task), [&] { return app::SweepTaskMain(sweep_task); }},
       {app::AddDivergence(&cli, &divergence), [&] { return app::DivergenceMain(divergence); }},
       {app::AddRender(&cli, &render), [&] { return app::RenderMain(render); }}};
   CLI11_PARSE(cli, argc, argv);

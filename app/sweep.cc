@@ -1,22 +1,15 @@
 #include "app/sweep.h"
 
-#include <signal.h>
-#include <spawn.h>
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
-#include <cstring>
 #include <deque>
-#include <fcntl.h>
 #include <filesystem>
 #include <limits>
 #include <stdexcept>
 #include <thread>
 
+#include "app/run_pool.h"
 #include "config/config.h"
 #include "eval/chi_square.h"
 #include "rundir/csv_reader.h"
@@ -25,8 +18,6 @@
 #include "rundir/manifest.h"
 #include "rundir/run_files.h"
 #include "rundir/summary.h"
-
-extern char** environ;
 
 namespace mjslam::app {
 namespace {
@@ -39,75 +30,17 @@ using rundir::PathIn;
 using rundir::ReadJsonFile;
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 
+// The layout of a sweep directory beyond a run's (docs/commands.md).
+constexpr char kSweepRecordFile[] = "sweep.json";
+constexpr char kCellsFolder[] = "cells";
+constexpr char kSlurmFolder[] = "slurm";
+constexpr char kCampaignTableFile[] = "campaign.csv";
+
 std::string RunName(int index) {
   char name[32];
   std::snprintf(name, sizeof(name), "run_%03d", index);
   return name;
 }
-
-// Starts `argv` with stdout and stderr appended to `log_path`.
-pid_t Spawn(const std::vector<std::string>& argv, const std::string& log_path) {
-  posix_spawn_file_actions_t actions;
-  posix_spawn_file_actions_init(&actions);
-  posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log_path.c_str(),
-                                   O_WRONLY | O_CREAT | O_APPEND, 0644);
-  posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
-  std::vector<char*> args;
-  for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
-  args.push_back(nullptr);
-  pid_t pid = -1;
-  const int error = posix_spawn(&pid, argv[0].c_str(), &actions, nullptr, args.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  if (error != 0) {
-    throw std::runtime_error("cannot start '" + argv[0] + "': " + std::strerror(error));
-  }
-  return pid;
-}
-
-// True when the run directory holds a completed run; `evaluated` tells if its
-// summary has the metrics of `mjslam evaluate`.
-bool Completed(const std::string& dir, bool* evaluated) {
-  nlohmann::json manifest;
-  nlohmann::json summary;
-  try {
-    manifest = ReadJsonFile(PathIn(dir, rundir::kManifestFile), nullptr);
-    summary = ReadJsonFile(PathIn(dir, rundir::kSummaryFile), nullptr);
-  } catch (const std::runtime_error&) {
-    return false;  // a file cut short: redo the run
-  }
-  if (!manifest.is_object() || manifest.value("status", "") != "completed") return false;
-  *evaluated = summary.is_object() && summary.contains("filters") &&
-               summary["filters"].contains("selective") &&
-               summary["filters"]["selective"].contains("mean_nees") &&
-               fs::exists(PathIn(dir, rundir::kGroundTruthMapFile));
-  return true;
-}
-
-// Mean over runs of the numbers at `pointer` in each run's summary (null if
-// none has one).
-nlohmann::json MeanOf(const std::vector<nlohmann::json>& summaries, const nlohmann::json::json_pointer& pointer) {
-  double sum = 0.0;
-  int count = 0;
-  for (const nlohmann::json& s : summaries) {
-    if (!s.contains(pointer)) continue;
-    const nlohmann::json& v = s.at(pointer);
-    if (!v.is_number()) continue;
-    sum += v.get<double>();
-    ++count;
-  }
-  return count > 0 ? nlohmann::json(sum / count) : nlohmann::json(nullptr);
-}
-
-// What a run of the sweep needs next.
-enum class Stage { kRun, kEvaluate };
-
-// One run of the sweep in the process pool.
-struct Job {
-  int index;
-  std::string dir;
-  Stage stage;
-  pid_t pid = -1;
-};
 
 // Checks the options; returns the number of runs at a time.
 int CheckedJobs(const SweepOptions& options) {
@@ -138,136 +71,281 @@ std::string PrepareSweepDirectory(const RunConfig& config, const std::string& di
   return config_path;
 }
 
-// The work left: a completed run is kept (and evaluated if its summary lacks
-// the metrics); any other is deleted and redone.
-std::deque<Job> PlanJobs(const std::vector<std::string>& run_dirs, const SweepOptions& options,
-                         SweepResult* result) {
-  std::deque<Job> pending;
-  for (int i = 0; i < static_cast<int>(run_dirs.size()); ++i) {
-    const std::string& run_dir = run_dirs[i];
+// The run directories of a cell.
+std::vector<std::string> RunDirs(const std::string& cell_dir, int runs) {
+  std::vector<std::string> dirs;
+  for (int i = 0; i < runs; ++i) {
+    dirs.push_back(PathIn(PathIn(cell_dir, rundir::kSweepRunsFolder), RunName(i)));
+  }
+  return dirs;
+}
+
+// out_dir/sweep.json: what `--aggregate DIR` needs to finish the sweep
+// without its command line (cell folders relative to DIR).
+nlohmann::json SweepRecord(const std::vector<SweepCell>& cells, int runs, bool campaign,
+                           const SweepOptions& options) {
+  nlohmann::json record;
+  record["campaign"] = campaign;
+  record["runs"] = runs;
+  record["backend"] = options.backend == SweepBackend::kSlurm ? "slurm" : "local";
+  record["evaluate_runs"] = options.evaluate_runs;
+  record["divergence_points"] = options.divergence_points;
+  record["cells"] = nlohmann::json::array();
+  for (const SweepCell& cell : cells) {
+    const std::string relative = fs::relative(cell.dir, options.out_dir).lexically_normal().string();
+    record["cells"].push_back({{"name", cell.cell.name},
+                               {"dir", relative},
+                               {"base_seed", cell.config.run.seed},
+                               {"overrides", cell.cell.overrides},
+                               {"labels", cell.cell.labels}});
+  }
+  return record;
+}
+
+// Refuses to touch a sweep whose job array is still in the queue: its tasks
+// write into the run directories a resume would delete.
+void RefuseWhileQueued(const std::string& dir) {
+  const std::optional<SlurmSubmission> last = LatestSubmission(PathIn(dir, kSlurmFolder));
+  if (last && JobInQueue(last->job_id)) {
+    throw std::runtime_error(dir + ": Slurm job " + last->job_id +
+                             " of this sweep is still in the queue; wait for it (mjslam sweep "
+                             "--aggregate " + dir + ") or cancel it (scancel " + last->job_id + ")");
+  }
+}
+
+RunPoolOptions PoolOptions(const SweepOptions& options) {
+  RunPoolOptions pool;
+  pool.program = options.program;
+  pool.evaluate_runs = options.evaluate_runs;
+  pool.divergence_points = options.divergence_points;
+  pool.verbose = options.verbose;
+  pool.stop_requested = options.stop_requested;
+  return pool;
+}
+
+// The runs of `submission` that have no completed (and, when evaluating,
+// evaluated) run directory, each with its logs.
+std::vector<std::string> UnfinishedRuns(const SlurmSubmission& submission, bool evaluate_runs) {
+  std::vector<std::string> unfinished;
+  for (std::size_t i = 0; i < submission.runs.size(); ++i) {
+    const std::string& dir = submission.runs[i].dir;
     bool evaluated = false;
-    if (Completed(run_dir, &evaluated)) {
-      ++result->runs_kept;
-      if (!evaluated && options.evaluate_runs) pending.push_back({i, run_dir, Stage::kEvaluate});
-      continue;
-    }
-    fs::remove_all(run_dir);
-    fs::remove(run_dir + ".log");
-    pending.push_back({i, run_dir, Stage::kRun});
+    if (IsCompletedRun(dir, &evaluated) && (evaluated || !evaluate_runs)) continue;
+    unfinished.push_back(dir + ": not completed; Slurm task " +
+                         std::to_string(i % static_cast<std::size_t>(submission.tasks)) +
+                         " of job " + submission.job_id + ", see " + submission.TaskLog(i) +
+                         " and " + dir + ".log");
   }
-  return pending;
+  return unfinished;
 }
 
-// Starts the process of `job`'s stage: `mjslam run` or `mjslam evaluate`.
-void StartJob(const RunConfig& config, const std::string& config_path, const SweepOptions& options,
-              Job* job) {
-  const std::uint64_t seed = config.run.seed + static_cast<std::uint64_t>(job->index);
-  if (job->stage == Stage::kRun) {
-    job->pid = Spawn({options.program, "run", "--quiet", "--no-render", "--no-evaluate",
-                      "--config", config_path, "--seed",
-                      std::to_string(seed), "--out", job->dir},
-                     job->dir + ".log");
-  } else {
-    job->pid = Spawn({options.program, "evaluate", job->dir, "--divergence-points",
-                      std::to_string(options.divergence_points)},
-                     job->dir + ".log");
+// Waits for `submission` (unless options.wait is false: then only says it
+// was submitted) and returns its unfinished runs.
+std::vector<std::string> AwaitSubmission(const SlurmSubmission& submission,
+                                         const SweepOptions& options, SweepResult* result) {
+  result->job_id = submission.job_id;
+  if (!options.wait) {
+    result->submitted = true;
+    return {};
   }
+  if (options.verbose) {
+    std::fprintf(stderr, "%s: waiting for Slurm job %s (%zu runs in %d array tasks)\n",
+                 options.out_dir.c_str(), submission.job_id.c_str(), submission.runs.size(),
+                 submission.tasks);
+  }
+  if (!WaitForJob(submission.job_id, options.slurm.poll_s, options.stop_requested)) {
+    result->interrupted = true;
+    return {};
+  }
+  return UnfinishedRuns(submission, options.evaluate_runs);
 }
 
-// Runs `pending`, `jobs` processes at a time; a run that succeeds is then
-// evaluated. Returns the failures; sets result->interrupted (and stops the
-// running processes) when a stop is requested.
-std::vector<std::string> RunJobs(std::deque<Job> pending, int jobs, const RunConfig& config,
-                                 const std::string& config_path, const SweepOptions& options,
-                                 SweepResult* result) {
-  std::vector<Job> active;
-  std::vector<std::string> failures;
-  while (!pending.empty() || !active.empty()) {
-    if (options.stop_requested != nullptr && *options.stop_requested != 0) {
-      // Stop the running ones; the next sweep redoes them.
-      for (const Job& job : active) ::kill(job.pid, SIGTERM);
-      for (const Job& job : active) ::waitpid(job.pid, nullptr, 0);
-      result->interrupted = true;
-      return failures;
-    }
-    while (static_cast<int>(active.size()) < jobs && !pending.empty()) {
-      Job job = pending.front();
-      pending.pop_front();
-      StartJob(config, config_path, options, &job);
-      active.push_back(job);
-    }
-    int status = 0;
-    const pid_t pid = ::waitpid(-1, &status, WNOHANG);
-    if (pid <= 0) {
-      std::this_thread::sleep_for(std::chrono::milliseconds(5));
-      continue;
-    }
-    for (std::size_t k = 0; k < active.size(); ++k) {
-      if (active[k].pid != pid) continue;
-      Job job = active[k];
-      active.erase(active.begin() + static_cast<std::ptrdiff_t>(k));
-      const bool ok = WIFEXITED(status) && WEXITSTATUS(status) == 0;
-      if (!ok) {
-        ++result->runs_failed;
-        failures.push_back(job.dir + (job.stage == Stage::kRun ? ": run" : ": evaluate") +
-                           " failed, see " + job.dir + ".log");
-      } else if (job.stage == Stage::kRun && options.evaluate_runs) {
-        job.stage = Stage::kEvaluate;
-        StartJob(config, config_path, options, &job);
-        active.push_back(job);
-        ++result->runs_made;
-      } else if (job.stage == Stage::kRun) {
-        ++result->runs_made;
-      } else if (options.verbose) {
-        std::fprintf(stderr, "%s: done\n", job.dir.c_str());
-      }
-      break;
-    }
+// Runs what is left of `runs` with the chosen backend. Returns the failures.
+std::vector<std::string> RunWhatIsLeft(std::vector<PlannedRun> runs, int jobs,
+                                       const SweepOptions& options, SweepResult* result) {
+  std::deque<PlannedRun> pending;
+  for (PlannedRun& run : runs) {
+    bool evaluated = false;
+    if (IsCompletedRun(run.dir, &evaluated)) ++result->runs_kept;
+    if (PlanRun(options.evaluate_runs, &run)) pending.push_back(run);
+  }
+  if (options.backend == SweepBackend::kLocal) {
+    const RunPoolResult pool = RunPool(pending, jobs, PoolOptions(options));
+    result->runs_made = pool.runs_made;
+    result->interrupted = pool.interrupted;
+    return pool.failures;
+  }
+  if (pending.empty()) return {};
+  const SlurmSubmission submission =
+      SubmitJobArray({pending.begin(), pending.end()}, PoolOptions(options), options.slurm,
+                     PathIn(options.out_dir, kSlurmFolder));
+  std::vector<std::string> failures = AwaitSubmission(submission, options, result);
+  for (const PlannedRun& run : pending) {
+    bool evaluated = false;
+    if (run.stage == RunStage::kRun && IsCompletedRun(run.dir, &evaluated)) ++result->runs_made;
   }
   return failures;
+}
+
+// Throws the list of failed runs, if any.
+void ThrowIfFailed(const std::vector<std::string>& failures, int total) {
+  if (failures.empty()) return;
+  std::string message = "sweep: " + std::to_string(failures.size()) + " of " +
+                        std::to_string(total) + " runs failed:";
+  for (const std::string& f : failures) message += "\n  " + f;
+  throw std::runtime_error(message);
+}
+
+// Aggregates every cell of the sweep recorded in `record` (sweep.json) into
+// its summary.json; a campaign also gets its table. Fills result's summaries.
+void AggregateCells(const nlohmann::json& record, const SweepOptions& options, SweepResult* result) {
+  const int runs = record.at("runs").get<int>();
+  std::vector<CampaignCell> cells;
+  for (const nlohmann::json& c : record.at("cells")) {
+    const std::string cell_dir = PathIn(options.out_dir, c.at("dir").get<std::string>());
+    const std::vector<std::string> run_dirs = RunDirs(cell_dir, runs);
+    nlohmann::json summary = AggregateSweep(run_dirs, cell_dir, options);
+    summary["sweep"]["runs_made"] = result->runs_made;
+    summary["sweep"]["runs_kept"] = result->runs_kept;
+    summary["sweep"]["base_seed"] = c.at("base_seed");
+    summary["sweep"]["backend"] = record.at("backend");
+    rundir::WriteSummary(cell_dir, summary);
+    if (!options.divergence_study_points.empty()) {
+      WriteDivergenceStudy(run_dirs.front(), options.divergence_study_points,
+                           options.divergence_study_realisations,
+                           PathIn(cell_dir, rundir::kDivergenceFile));
+    }
+    result->cell_summaries.push_back(summary);
+    cells.push_back({c.at("name").get<std::string>(),
+                     c.at("overrides").get<std::vector<std::string>>(),
+                     c.at("labels").get<std::vector<std::pair<std::string, std::string>>>()});
+  }
+  if (record.at("campaign").get<bool>()) {
+    rundir::WriteFileAtomically(PathIn(options.out_dir, kCampaignTableFile),
+                                CampaignTableCsv(cells, result->cell_summaries));
+    result->table = CampaignTableText(cells, result->cell_summaries);
+  } else {
+    result->summary = result->cell_summaries.front();
+  }
+}
+
+// RunSweep and RunCampaign: prepares every cell, runs what is left, and
+// aggregates.
+SweepResult RunCells(const std::vector<SweepCell>& cells, int runs, bool campaign,
+                     SweepOptions options) {
+  options.runs = runs;
+  const int jobs = CheckedJobs(options);
+  const std::string& dir = options.out_dir;
+  // A resume while the sweep still runs would start its runs beside it.
+  const rundir::RunDirectoryLock lock(dir);
+  if (options.backend == SweepBackend::kSlurm) RefuseWhileQueued(dir);
+
+  // Each cell's folder and config; then every run of every cell.
+  std::vector<PlannedRun> planned;
+  for (const SweepCell& cell : cells) {
+    cell.config.ValidateOrThrow();
+    const std::string config_path = PrepareSweepDirectory(cell.config, cell.dir);
+    const std::vector<std::string> run_dirs = RunDirs(cell.dir, runs);
+    for (int i = 0; i < runs; ++i) {
+      planned.push_back({fs::absolute(config_path).lexically_normal().string(),
+                         cell.config.run.seed + static_cast<std::uint64_t>(i),
+                         fs::absolute(run_dirs[i]).lexically_normal().string(), RunStage::kRun});
+    }
+  }
+  const nlohmann::json record = SweepRecord(cells, runs, campaign, options);
+  rundir::WriteJsonAtomically(PathIn(dir, kSweepRecordFile), record);
+
+  // Run and evaluate what is missing; then the aggregates.
+  SweepResult result;
+  const std::vector<std::string> failures = RunWhatIsLeft(planned, jobs, options, &result);
+  if (result.interrupted || result.submitted) return result;
+  result.runs_failed = static_cast<int>(failures.size());
+  ThrowIfFailed(failures, static_cast<int>(planned.size()));
+  AggregateCells(record, options, &result);
+  if (!campaign && options.backend == SweepBackend::kLocal) {
+    result.summary["sweep"]["jobs"] = jobs;
+    rundir::WriteSummary(dir, result.summary);
+  }
+  return result;
 }
 
 }  // namespace
 
 SweepResult RunSweep(const RunConfig& config, const SweepOptions& options) {
-  config.ValidateOrThrow();
-  const int jobs = CheckedJobs(options);
-  const std::string& dir = options.out_dir;
-  // A resume while the sweep still runs would start its runs beside it.
-  const rundir::RunDirectoryLock lock(dir);
-  const std::string config_path = PrepareSweepDirectory(config, dir);
-  std::vector<std::string> run_dirs;
-  for (int i = 0; i < options.runs; ++i) {
-    run_dirs.push_back(PathIn(PathIn(dir, rundir::kSweepRunsFolder), RunName(i)));
-  }
+  SweepCell cell{CampaignCell{}, options.out_dir, config};
+  return RunCells({cell}, options.runs, false, options);
+}
 
-  // Run and evaluate what is missing, J processes at a time.
+SweepResult RunCampaign(const CampaignParams& campaign, const std::string& config_path,
+                        const std::vector<std::string>& overrides, const SweepOptions& options) {
+  ThrowIfProblems(campaign.Validate());
+  std::vector<SweepCell> cells;
+  for (const CampaignCell& cell : CampaignCells(campaign)) {
+    std::vector<std::string> cell_overrides = overrides;
+    cell_overrides.insert(cell_overrides.end(), cell.overrides.begin(), cell.overrides.end());
+    RunConfig config;
+    try {
+      config = LoadRunConfig(config_path, cell_overrides);
+    } catch (const std::runtime_error& error) {
+      throw std::runtime_error("campaign cell " + cell.name + ":\n" + error.what());
+    }
+    cells.push_back({cell, PathIn(PathIn(options.out_dir, kCellsFolder), cell.name), config});
+  }
+  return RunCells(cells, campaign.runs > 0 ? campaign.runs : options.runs, true, options);
+}
+
+SweepResult AggregateSweepDirectory(const std::string& dir, const SweepOptions& options) {
+  const nlohmann::json record = ReadJsonFile(PathIn(dir, kSweepRecordFile), nullptr);
+  if (!record.is_object() || !record.contains("cells") || !record.contains("runs")) {
+    throw std::runtime_error(PathIn(dir, kSweepRecordFile) +
+                             ": missing or not a sweep record; is " + dir + " a sweep directory?");
+  }
+  SweepOptions with_dir = options;
+  with_dir.out_dir = dir;
+  with_dir.evaluate_runs = record.value("evaluate_runs", true);
   SweepResult result;
-  const std::vector<std::string> failures =
-      RunJobs(PlanJobs(run_dirs, options, &result), jobs, config, config_path, options, &result);
-  if (result.interrupted) return result;
-  if (!failures.empty()) {
-    std::string message = "sweep: " + std::to_string(failures.size()) + " of " +
-                          std::to_string(options.runs) + " runs failed:";
-    for (const std::string& f : failures) message += "\n  " + f;
-    throw std::runtime_error(message);
+  // The last job array: wait for it, then list what it left unfinished.
+  const std::optional<SlurmSubmission> last = LatestSubmission(PathIn(dir, kSlurmFolder));
+  if (last) {
+    with_dir.wait = true;
+    const std::vector<std::string> failures = AwaitSubmission(*last, with_dir, &result);
+    if (result.interrupted) return result;
+    result.runs_failed = static_cast<int>(failures.size());
+    ThrowIfFailed(failures, static_cast<int>(last->runs.size()));
   }
-
-  // The aggregate, and the divergence study of the first run.
-  result.summary = AggregateSweep(run_dirs, dir, options);
-  result.summary["sweep"]["runs_made"] = result.runs_made;
-  result.summary["sweep"]["runs_kept"] = result.runs_kept;
-  result.summary["sweep"]["base_seed"] = config.run.seed;
-  result.summary["sweep"]["jobs"] = jobs;
-  rundir::WriteSummary(dir, result.summary);
-  if (!options.divergence_study_points.empty()) {
-    WriteDivergenceStudy(run_dirs.front(), options.divergence_study_points,
-                         options.divergence_study_realisations, PathIn(dir, rundir::kDivergenceFile));
+  // Every run of every cell must be there (a local sweep stopped early).
+  std::vector<std::string> missing;
+  for (const nlohmann::json& c : record.at("cells")) {
+    for (const std::string& run_dir :
+         RunDirs(PathIn(dir, c.at("dir").get<std::string>()), record.at("runs").get<int>())) {
+      bool evaluated = false;
+      if (!IsCompletedRun(run_dir, &evaluated) || (with_dir.evaluate_runs && !evaluated)) {
+        missing.push_back(run_dir + ": not completed; run the sweep's command again to resume");
+      }
+    }
   }
+  result.runs_failed = static_cast<int>(missing.size());
+  ThrowIfFailed(missing, record.at("runs").get<int>() * static_cast<int>(record.at("cells").size()));
+  AggregateCells(record, with_dir, &result);
   return result;
 }
 
 namespace {
+
+// Mean over runs of the numbers at `pointer` in each run's summary (null if
+// none has one).
+nlohmann::json MeanOf(const std::vector<nlohmann::json>& summaries, const nlohmann::json::json_pointer& pointer) {
+  double sum = 0.0;
+  int count = 0;
+  for (const nlohmann::json& s : summaries) {
+    if (!s.contains(pointer)) continue;
+    const nlohmann::json& v = s.at(pointer);
+    if (!v.is_number()) continue;
+    sum += v.get<double>();
+    ++count;
+  }
+  return count > 0 ? nlohmann::json(sum / count) : nlohmann::json(nullptr);
+}
 
 // What the aggregate reads of each run: per filter and run the NEES of every
 // step and the time totals; per run the times and the summary.

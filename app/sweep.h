@@ -7,10 +7,18 @@
 
 #include <nlohmann/json.hpp>
 
+#include "app/campaign.h"
 #include "app/evaluate.h"
 #include "app/run_config.h"
+#include "app/slurm.h"
 
 namespace mjslam::app {
+
+/// Where the runs of a sweep run.
+enum class SweepBackend {
+  kLocal,  ///< processes on this machine, `jobs` at a time
+  kSlurm,  ///< one Slurm job array (app/slurm.h)
+};
 
 /// How `mjslam sweep` runs its Monte Carlo.
 struct SweepOptions {
@@ -42,9 +50,27 @@ struct SweepOptions {
   double bounds_probability = 0.95;
   /// Print one line per finished run to stderr.
   bool verbose = true;
+  /// Local processes or a Slurm job array.
+  SweepBackend backend = SweepBackend::kLocal;
+  /// The job array's settings (kSlurm).
+  SlurmOptions slurm;
+  /// kSlurm: wait for the array to leave the queue, then aggregate; false:
+  /// return once submitted (`mjslam sweep --aggregate DIR` finishes).
+  bool wait = true;
   /// Set asynchronously (signal handler) to stop: running runs are stopped
   /// (and redone by the next sweep), nothing is aggregated.
   const volatile std::sig_atomic_t* stop_requested = nullptr;
+};
+
+/// One cell of a sweep: `runs` runs of one config in its own sweep
+/// directory (config.yaml, runs/, nees.csv, summary.json).
+struct SweepCell {
+  /// The grid cell (name, overrides, labels); empty for a plain sweep.
+  CampaignCell cell;
+  /// Its sweep directory: the sweep's own for a plain sweep, else
+  /// out_dir/cells/<name>.
+  std::string dir;
+  RunConfig config;
 };
 
 /// What a sweep did.
@@ -54,21 +80,50 @@ struct SweepResult {
   int runs_kept = 0;
   int runs_failed = 0;
   bool interrupted = false;
-  /// The aggregate written to out_dir/summary.json.
+  /// kSlurm without waiting: the job array was submitted (or nothing was
+  /// left to run); no aggregate yet.
+  bool submitted = false;
+  /// The submitted job's id (kSlurm; empty when nothing was left to run).
+  std::string job_id;
+  /// The aggregate written to out_dir/summary.json (a plain sweep).
   nlohmann::json summary;
+  /// Per cell, in order: its aggregate (a campaign; the plain sweep's one).
+  std::vector<nlohmann::json> cell_summaries;
+  /// The table across cells (a campaign): as printed.
+  std::string table;
 };
 
 /// Runs a Monte Carlo sweep: `config` (already loaded, with its overrides) is
 /// written to out_dir/config.yaml, and run i is `program run --config
 /// out_dir/config.yaml --seed <run.seed + i> --out out_dir/runs/<name>`
-/// followed by `program evaluate`, `jobs` runs at a time. So each run's files
-/// are those of a single `mjslam run` with that seed. Resumable: a run whose
+/// followed by `program evaluate`, `jobs` runs at a time (kLocal) or in one
+/// Slurm job array (kSlurm). So each run's files are those of a single
+/// `mjslam run` with that seed, whatever the backend. Resumable: a run whose
 /// manifest says completed is kept (and only evaluated if its summary lacks
 /// the metrics); any other is deleted and redone. A sweep directory made with
-/// another config is refused (std::runtime_error naming its config.yaml).
-/// Then aggregates (AggregateSweep). Throws std::runtime_error when a run or
-/// evaluation fails, after the other runs have finished.
+/// another config is refused (std::runtime_error naming its config.yaml), and
+/// so is one whose Slurm job is still in the queue. Then aggregates
+/// (AggregateSweep). Throws std::runtime_error when runs or evaluations fail,
+/// after the others have finished, listing each with its log (and its Slurm
+/// task's log).
 SweepResult RunSweep(const RunConfig& config, const SweepOptions& options);
+
+/// A campaign: RunSweep over every cell of `campaign` (each cell's config is
+/// `config_path` with `overrides`, then the cell's own overrides), all cells'
+/// runs in one pool or one job array, each cell in out_dir/cells/<name>/;
+/// then every cell's aggregate, and the table across cells written to
+/// out_dir/campaign.csv (CampaignTableCsv) and returned as text. Runs per
+/// cell: campaign.runs, else options.runs. Throws as RunSweep, and
+/// config::ConfigError when a cell's config is bad (naming the cell).
+SweepResult RunCampaign(const CampaignParams& campaign, const std::string& config_path,
+                        const std::vector<std::string>& overrides, const SweepOptions& options);
+
+/// `mjslam sweep --aggregate DIR`: finishes a sweep or campaign started with
+/// `--no-wait`: waits while its Slurm job is in the queue, then aggregates as
+/// RunSweep or RunCampaign would (from DIR/sweep.json). Throws
+/// std::runtime_error listing the runs without a completed, evaluated run
+/// directory, each with its Slurm task's log.
+SweepResult AggregateSweepDirectory(const std::string& dir, const SweepOptions& options);
 
 /// The aggregate of the completed runs `run_dirs` of a sweep: writes
 /// out_dir/nees.csv (t,classical_anees,selective_anees,lower,upper,n_runs:
