@@ -346,7 +346,12 @@ int SweepMain(const CLI::App& sweep, SweepCommand c) {
     return 0;
   }
   PrintSweep(result);
-  std::fprintf(stderr, "%s: %d runs made, %d kept\n", dir.c_str(), result.runs_made, result.runs_kept);
+  if (c.aggregate_dir.empty()) {
+    std::fprintf(stderr, "%s: %d runs made, %d kept\n", dir.c_str(), result.runs_made,
+                 result.runs_kept);
+  } else {
+    std::fprintf(stderr, "%s: aggregated\n", dir.c_str());
+  }
   return 0;
 }
 

@@ -300,6 +300,7 @@ SweepResult AggregateSweepDirectory(const std::string& dir, const SweepOptions& 
     throw std::runtime_error(PathIn(dir, kSweepRecordFile) +
                              ": missing or not a sweep record; is " + dir + " a sweep directory?");
   }
+  const rundir::RunDirectoryLock lock(dir);
   SweepOptions with_dir = options;
   with_dir.out_dir = dir;
   with_dir.evaluate_runs = record.value("evaluate_runs", true);
