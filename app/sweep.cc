@@ -80,6 +80,12 @@ std::vector<std::string> RunDirs(const std::string& cell_dir, int runs) {
   return dirs;
 }
 
+// The folder of a cell recorded in sweep.json ("." for a plain sweep).
+std::string CellDir(const std::string& out_dir, const nlohmann::json& cell) {
+  const std::string relative = cell.at("dir").get<std::string>();
+  return relative == "." ? out_dir : PathIn(out_dir, relative);
+}
+
 // out_dir/sweep.json: what `--aggregate DIR` needs to finish the sweep
 // without its command line (cell folders relative to DIR).
 nlohmann::json SweepRecord(const std::vector<SweepCell>& cells, int runs, bool campaign,
@@ -202,7 +208,7 @@ void AggregateCells(const nlohmann::json& record, const SweepOptions& options, S
   const int runs = record.at("runs").get<int>();
   std::vector<CampaignCell> cells;
   for (const nlohmann::json& c : record.at("cells")) {
-    const std::string cell_dir = PathIn(options.out_dir, c.at("dir").get<std::string>());
+    const std::string cell_dir = CellDir(options.out_dir, c);
     const std::vector<std::string> run_dirs = RunDirs(cell_dir, runs);
     nlohmann::json summary = AggregateSweep(run_dirs, cell_dir, options);
     summary["sweep"]["runs_made"] = result->runs_made;
@@ -318,7 +324,7 @@ SweepResult AggregateSweepDirectory(const std::string& dir, const SweepOptions& 
   std::vector<std::string> missing;
   for (const nlohmann::json& c : record.at("cells")) {
     for (const std::string& run_dir :
-         RunDirs(PathIn(dir, c.at("dir").get<std::string>()), record.at("runs").get<int>())) {
+         RunDirs(CellDir(dir, c), record.at("runs").get<int>())) {
       bool evaluated = false;
       if (!IsCompletedRun(run_dir, &evaluated) || (with_dir.evaluate_runs && !evaluated)) {
         missing.push_back(run_dir + ": not completed; run the sweep's command again to resume");

@@ -19,6 +19,7 @@ packages=(
   ffmpeg               # ffmpeg/ffprobe: video.mp4 of the renders (H.264), its test
   python3-matplotlib   # matplotlib: the plots of runs and sweeps (renders/report.py)
   chromium             # headless Chromium: the test that index.html loads
+  slurm-wlm munge      # Slurm: the one-node cluster of the sweep's Slurm test (scripts/slurm_localhost.sh)
 )
 
 missing=()
