@@ -91,6 +91,19 @@ TEST(CampaignTest, FileErrorsNameTheFileLineAndKey) {
   }
 }
 
+TEST(CampaignTest, EveryShippedCampaignLoadsAndItsWorldsExist) {
+  int count = 0;
+  for (const auto& entry :
+       fs::directory_iterator(fs::path(MJSLAM_SOURCE_DIR) / "configs" / "campaigns")) {
+    SCOPED_TRACE(entry.path().string());
+    const CampaignParams campaign = LoadCampaign(entry.path().string());
+    for (const std::string& world : campaign.worlds) EXPECT_TRUE(fs::exists(world)) << world;
+    EXPECT_GE(CampaignCells(campaign).size(), 2u);
+    ++count;
+  }
+  EXPECT_GE(count, 1);
+}
+
 TEST(CampaignTest, TableHasOneRowPerCellWithItsLabelsAndVerdicts) {
   CampaignParams campaign;
   campaign.worlds = {"/w/room.xml"};
