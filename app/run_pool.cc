@@ -34,16 +34,14 @@ pid_t Spawn(const std::vector<std::string>& argv, const std::string& log_path) {
   posix_spawn_file_actions_addopen(&actions, STDOUT_FILENO, log_path.c_str(),
                                    O_WRONLY | O_CREAT | O_APPEND, 0644);
   posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
-  std::vector<char*> args;
-  for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
-  args.push_back(nullptr);
-  pid_t pid = -1;
-  const int error = posix_spawn(&pid, argv[0].c_str(), &actions, nullptr, args.data(), environ);
-  posix_spawn_file_actions_destroy(&actions);
-  if (error != 0) {
-    throw std::runtime_error("cannot start '" + argv[0] + "': " + std::strerror(error));
+  try {
+    const pid_t pid = StartProcess(argv, actions, false);
+    posix_spawn_file_actions_destroy(&actions);
+    return pid;
+  } catch (...) {
+    posix_spawn_file_actions_destroy(&actions);
+    throw;
   }
-  return pid;
 }
 
 // A run in the pool and its process.
@@ -70,6 +68,21 @@ double CpuSeconds(const struct rusage& usage) {
 }
 
 }  // namespace
+
+pid_t StartProcess(const std::vector<std::string>& argv, const posix_spawn_file_actions_t& actions,
+                   bool search_path) {
+  std::vector<char*> args;
+  for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
+  args.push_back(nullptr);
+  pid_t pid = -1;
+  const int error = search_path
+                        ? posix_spawnp(&pid, argv[0].c_str(), &actions, nullptr, args.data(), environ)
+                        : posix_spawn(&pid, argv[0].c_str(), &actions, nullptr, args.data(), environ);
+  if (error != 0) {
+    throw std::runtime_error("cannot start '" + argv[0] + "': " + std::strerror(error));
+  }
+  return pid;
+}
 
 bool IsCompletedRun(const std::string& dir, bool* evaluated) {
   nlohmann::json manifest;

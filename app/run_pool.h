@@ -5,6 +5,7 @@
 // (all runs on this machine) and by each task of the Slurm backend (its share
 // of the runs, one at a time).
 
+#include <spawn.h>
 #include <sys/types.h>
 
 #include <csignal>
@@ -56,6 +57,12 @@ struct RunPoolResult {
   /// CPU seconds (user + system) of all the processes the pool waited for.
   double child_cpu_s = 0.0;
 };
+
+/// Starts `argv` with `actions` applied in the child (argv[0] is a path, or a
+/// name looked up in PATH when `search_path`). Throws std::runtime_error
+/// naming argv[0] and the reason when it cannot be started.
+pid_t StartProcess(const std::vector<std::string>& argv, const posix_spawn_file_actions_t& actions,
+                   bool search_path);
 
 /// True when `dir` holds a completed run (manifest status "completed" and a
 /// readable summary.json); `*evaluated` tells whether its summary has the

@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cctype>
 #include <chrono>
 #include <cstdio>
 #include <cstring>
@@ -17,8 +18,6 @@
 
 #include "rundir/manifest.h"
 #include "rundir/run_files.h"
-
-extern char** environ;
 
 namespace mjslam::app {
 namespace {
@@ -46,18 +45,17 @@ CommandOutput Capture(const std::vector<std::string>& argv) {
   posix_spawn_file_actions_adddup2(&actions, pipe_fds[1], STDOUT_FILENO);
   posix_spawn_file_actions_adddup2(&actions, pipe_fds[1], STDERR_FILENO);
   posix_spawn_file_actions_addclose(&actions, pipe_fds[0]);
-  std::vector<char*> args;
-  for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
-  args.push_back(nullptr);
   pid_t pid = -1;
-  const int error = posix_spawnp(&pid, argv[0].c_str(), &actions, nullptr, args.data(), environ);
+  try {
+    pid = StartProcess(argv, actions, true);
+  } catch (const std::runtime_error& error) {
+    posix_spawn_file_actions_destroy(&actions);
+    ::close(pipe_fds[0]);
+    ::close(pipe_fds[1]);
+    throw std::runtime_error(std::string(error.what()) + ": is Slurm installed and in PATH?");
+  }
   posix_spawn_file_actions_destroy(&actions);
   ::close(pipe_fds[1]);
-  if (error != 0) {
-    ::close(pipe_fds[0]);
-    throw std::runtime_error("cannot run '" + argv[0] + "' (" + std::strerror(error) +
-                             "): is Slurm installed and in PATH?");
-  }
   CommandOutput output;
   char buffer[4096];
   for (ssize_t n; (n = ::read(pipe_fds[0], buffer, sizeof(buffer))) != 0;) {
