@@ -16,8 +16,10 @@
 #              for disk, starting processes, the serial aggregate at the end)
 # then the speed-up wall(1) / wall(2), the speed-up the CPU cost alone allows
 # (2 * cpu(1) / cpu(2)), the aggregate's own time (`mjslam sweep --aggregate`
-# on the finished sweep) and the load average before and after: a speed-up
-# is only meaningful on a machine with nothing else running.
+# on the finished sweep; a serial part), the machine's own ceiling (one
+# CPU-bound loop alone against two at once: what 2 cores give a program that
+# shares nothing) and the load average before and after: a speed-up is only
+# meaningful on a machine with nothing else running.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -62,12 +64,18 @@ for trial in $(seq "$trials"); do
   done
 done
 TIMEFORMAT='%R'
-aggregate_s=$( { time "$program" sweep --aggregate "$work/t1_j2" >/dev/null 2>&1; } 2>&1)
+aggregate_s=$( { time "$program" sweep --aggregate "$work/t1_j2" >/dev/null 2>&1 || true; } 2>&1)
+# The machine: the same fixed CPU-bound work once alone, then twice at once.
+loop() { awk 'BEGIN { for (i = 0; i < 4e7; i++) s += i * 0.5; print s > "/dev/null" }'; }
+alone_s=$( { time loop; } 2>&1)
+both_s=$( { time { loop & loop & wait; }; } 2>&1)
 echo "load average after: $(cut -d' ' -f1-3 /proc/loadavg)"
 awk -v w1="${wall[1]}" -v w2="${wall[2]}" -v c1="${cpu[1]}" -v c2="${cpu[2]}" -v a="$aggregate_s" \
-  -v n="$trials" 'BEGIN {
+  -v n="$trials" -v alone="$alone_s" -v both="$both_s" 'BEGIN {
     printf "all trials: jobs 1 %.3f s (cpu %.3f), jobs 2 %.3f s (cpu %.3f)\n", w1, c1, w2, c2
     printf "speed-up of 2 jobs: %.3f (the CPU cost alone allows %.3f); idle with 2 jobs: %.3f core-s per trial\n",
            w1 / w2, 2 * c1 / c2, (2 * w2 - c2) / n
     printf "the aggregate alone (mjslam sweep --aggregate): %.3f s\n", a
+    printf "the machine: a CPU-bound loop alone %.3f s, two at once %.3f s: ceiling %.3f\n",
+           alone, both, 2 * alone / both
   }'
