@@ -109,7 +109,8 @@ nlohmann::json SweepRecord(const std::vector<SweepCell>& cells, int runs, bool c
 }
 
 // Refuses to touch a sweep whose job array is still in the queue: its tasks
-// write into the run directories a resume would delete.
+// write into the run directories a resume would delete (whatever the backend
+// of the resume). Asks squeue only when the sweep has a submission.
 void RefuseWhileQueued(const std::string& dir) {
   const std::optional<SlurmSubmission> last = LatestSubmission(PathIn(dir, kSlurmFolder));
   if (last && JobInQueue(last->job_id)) {
@@ -244,7 +245,7 @@ SweepResult RunCells(const std::vector<SweepCell>& cells, int runs, bool campaig
   const std::string& dir = options.out_dir;
   // A resume while the sweep still runs would start its runs beside it.
   const rundir::RunDirectoryLock lock(dir);
-  if (options.backend == SweepBackend::kSlurm) RefuseWhileQueued(dir);
+  RefuseWhileQueued(dir);
 
   // Each cell's folder and config; then every run of every cell.
   std::vector<PlannedRun> planned;
