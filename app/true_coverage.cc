@@ -44,11 +44,18 @@ TrueCoverage::TrueCoverage(const std::vector<sim::ObstacleFootprint>& obstacles,
   // with (grid area) x (number of obstacles).
   Grid2<double> clearance(limits_, std::numeric_limits<double>::infinity());
   for (const sim::ObstacleFootprint& o : obstacles) {
-    const double r = (o.shape == sim::ObstacleFootprint::Shape::kCircle ? o.radius_m
-                                                                        : o.half_extents_m.norm()) +
-                     robot_radius_m + cell_m;
-    const Eigen::Vector2i lo_cell = limits_.CellOf(Eigen::Vector2d(o.X_WO.x - r, o.X_WO.y - r));
-    const Eigen::Vector2i hi_cell = limits_.CellOf(Eigen::Vector2d(o.X_WO.x + r, o.X_WO.y + r));
+    // The footprint's axis-aligned half extents in W, widened.
+    Eigen::Vector2d half = Eigen::Vector2d::Constant(o.radius_m);
+    if (o.shape == sim::ObstacleFootprint::Shape::kRectangle) {
+      const double c = std::abs(std::cos(o.X_WO.theta));
+      const double s = std::abs(std::sin(o.X_WO.theta));
+      half = Eigen::Vector2d(c * o.half_extents_m.x() + s * o.half_extents_m.y(),
+                             s * o.half_extents_m.x() + c * o.half_extents_m.y());
+    }
+    half.array() += robot_radius_m + cell_m;
+    const Eigen::Vector2d p_WO(o.X_WO.x, o.X_WO.y);
+    const Eigen::Vector2i lo_cell = limits_.CellOf(p_WO - half);
+    const Eigen::Vector2i hi_cell = limits_.CellOf(p_WO + half);
     for (int j = std::max(0, lo_cell.y()); j <= std::min(height - 1, hi_cell.y()); ++j) {
       for (int i = std::max(0, lo_cell.x()); i <= std::min(width - 1, hi_cell.x()); ++i) {
         const double distance = sim::DistanceToFootprint(limits_.CellCenter(i, j), o);
