@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include <mujoco/mujoco.h>
+
 #include "common/check.h"
 #include "common/grid2.h"
 
