@@ -1,26 +1,11 @@
 #include "app/cpu_profile.h"
 
-#include <time.h>
-
 #include <cstdio>
 #include <string>
 #include <utility>
 #include <vector>
 
 namespace mjslam::app {
-namespace {
-
-double ClockSeconds(clockid_t clock) {
-  timespec now{};
-  clock_gettime(clock, &now);
-  return static_cast<double>(now.tv_sec) + 1e-9 * static_cast<double>(now.tv_nsec);
-}
-
-}  // namespace
-
-double ThreadCpuSeconds() { return ClockSeconds(CLOCK_THREAD_CPUTIME_ID); }
-
-double ProcessCpuSeconds() { return ClockSeconds(CLOCK_PROCESS_CPUTIME_ID); }
 
 std::string PhaseCpuReport(const PhaseCpu& cpu, double sim_time_s, double process_cpu_s) {
   const std::vector<std::pair<const char*, double>> phases = {

@@ -2,22 +2,15 @@
 
 #include <string>
 
+#include "common/cpu_time.h"
+
 namespace mjslam::app {
 
-/// CPU time (user + system) the calling thread has used so far, seconds
-/// (POSIX CLOCK_THREAD_CPUTIME_ID).
-double ThreadCpuSeconds();
-
-/// CPU time (user + system) the whole process has used so far, seconds, all
-/// threads together (POSIX CLOCK_PROCESS_CPUTIME_ID): includes loading the
-/// program and its libraries.
-double ProcessCpuSeconds();
-
 /// CPU seconds a simulated run spent in each of its phases, as `mjslam run
-/// --profile` prints them. Measured with ThreadCpuSeconds() around each
-/// phase of every step (a few clock reads per step). What is not in a phase
-/// (setup, the loop's own bookkeeping, the maps and summary at the end) is
-/// the rest of RunSimulation's CPU time.
+/// --profile` prints them. Measured with ThreadCpuSeconds()
+/// (common/cpu_time.h) around each phase of every step (a few clock reads
+/// per step). What is not in a phase (setup, the loop's own bookkeeping, the
+/// maps and summary at the end) is the rest of RunSimulation's CPU time.
 struct PhaseCpu {
   /// The physics: Simulator::Advance (mj_step) and the contact count.
   double physics_s = 0.0;

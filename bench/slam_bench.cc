@@ -11,7 +11,6 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <ctime>
 #include <vector>
 
 #include <Eigen/Core>
@@ -19,6 +18,7 @@
 #include <benchmark/benchmark.h>
 
 #include "common/angles.h"
+#include "common/cpu_time.h"
 #include "common/laser_scan.h"
 #include "common/pose2.h"
 #include "common/records.h"
@@ -242,12 +242,6 @@ BENCHMARK(BM_SelectiveStep)->Apply(MapSizes)->Unit(benchmark::kMicrosecond);
 // in thread CPU time (other jobs on the machine do not count).
 // Counters: the mean of each, the corrections per step, and
 // ratio = step / (corrections x pass); the target is ratio <= 2.
-double ThreadCpuSeconds() {
-  timespec now{};
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &now);
-  return static_cast<double>(now.tv_sec) + 1e-9 * static_cast<double>(now.tv_nsec);
-}
-
 void BM_ClassicalStepOverPasses(benchmark::State& state) {
   EkfSlam filter = MakeFilter(static_cast<int>(state.range(0)), CorrectionMode::kClassical);
   Rng rng(11);

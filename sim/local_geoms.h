@@ -62,11 +62,6 @@ class LocalGeoms {
   /// scratch at its next call.
   void RestoreContacts(mjModel* m);
 
-  /// Number of static world geoms in the grid, and of those now candidates
-  /// for contacts (for benchmarks and tests).
-  int num_static() const { return static_cast<int>(static_geom_.size()); }
-  int num_contact_candidates() const { return static_cast<int>(enabled_.size()); }
-
  private:
   // mj_ray's per-geom distance: mesh, height field or primitive.
   static mjtNum RayGeom(const mjModel& m, const mjData& d, int geom, const mjtNum pnt[3],
