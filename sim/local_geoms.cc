@@ -82,10 +82,20 @@ LocalGeoms::LocalGeoms(const mjModel& m, const mjData& d, const RobotIndices& id
     ray_eligible_.push_back(ray ? 1 : 0);
     contype_.push_back(m.geom_contype[geom]);
     conaffinity_.push_back(m.geom_conaffinity[geom]);
+    sameframe_.push_back(m.geom_sameframe[geom]);
+    xpos_.insert(xpos_.end(), d.geom_xpos + 3 * geom, d.geom_xpos + 3 * geom + 3);
+    xmat_.insert(xmat_.end(), d.geom_xmat + 9 * geom, d.geom_xmat + 9 * geom + 9);
     boxes.push_back(FootprintBox(m, d, geom));
     world_margin = std::max(world_margin, static_cast<double>(m.geom_margin[geom]));
   }
   grid_ = BoxGrid(std::move(boxes), kCellM);
+  for (int site = 0; site < m.nsite; ++site) {
+    if (m.body_weldid[m.site_bodyid[site]] != 0) continue;
+    static_site_.push_back(site);
+    site_sameframe_.push_back(m.site_sameframe[site]);
+    site_xpos_.insert(site_xpos_.end(), d.site_xpos + 3 * site, d.site_xpos + 3 * site + 3);
+    site_xmat_.insert(site_xmat_.end(), d.site_xmat + 9 * site, d.site_xmat + 9 * site + 9);
+  }
   ray_stamp_.assign(static_geom_.size(), 0);
 
   // The robot's reach from its root body: each colliding geom's bounding
@@ -106,28 +116,40 @@ LocalGeoms::LocalGeoms(const mjModel& m, const mjData& d, const RobotIndices& id
   contact_radius_m_ = reach + world_margin + kContactSlackM + kContactExtraM;
 }
 
-mjtNum LocalGeoms::RayGeom(const mjModel& m, const mjData& d, int geom, const mjtNum pnt[3],
-                           const mjtNum vec[3]) {
+mjtNum LocalGeoms::RayGeom(const mjModel& m, const mjData& d, int geom, int box,
+                           const mjtNum pnt[3], const mjtNum vec[3]) const {
   switch (m.geom_type[geom]) {
     case mjGEOM_MESH:
       return mj_rayMesh(&m, &d, geom, pnt, vec);
     case mjGEOM_HFIELD:
       return mj_rayHfield(&m, &d, geom, pnt, vec);
     default:
+      if (box >= 0) {
+        return mju_rayGeom(xpos_.data() + 3 * box, xmat_.data() + 9 * box,
+                           m.geom_size + 3 * geom, pnt, vec, m.geom_type[geom]);
+      }
       return mju_rayGeom(d.geom_xpos + 3 * geom, d.geom_xmat + 9 * geom, m.geom_size + 3 * geom,
                          pnt, vec, m.geom_type[geom]);
   }
+}
+
+// A mesh keeps its pose computed (mj_rayMesh reads it from mjData).
+void LocalGeoms::SetActive(mjModel* m, int id, bool active) const {
+  const int geom = static_geom_[id];
+  m->geom_contype[geom] = active ? contype_[id] : 0;
+  m->geom_conaffinity[geom] = active ? conaffinity_[id] : 0;
+  if (m->geom_type[geom] != mjGEOM_MESH) m->geom_sameframe[geom] = active ? sameframe_[id] : 1;
 }
 
 mjtNum LocalGeoms::CastRay(const mjModel& m, const mjData& d, const mjtNum pnt[3],
                            const mjtNum vec[3], double max_range) const {
   // The nearest of mj_ray's candidates, as mj_ray keeps it.
   mjtNum distance = -1;
-  const auto consider = [&](int geom) {
-    const mjtNum candidate = RayGeom(m, d, geom, pnt, vec);
+  const auto consider = [&](int geom, int box) {
+    const mjtNum candidate = RayGeom(m, d, geom, box, pnt, vec);
     if (candidate >= 0 && (candidate < distance || distance < 0)) distance = candidate;
   };
-  for (const int geom : always_ray_) consider(geom);
+  for (const int geom : always_ray_) consider(geom, -1);
   if (grid_.num_boxes() == 0) return distance;
 
   // A new stamp for this ray (on wrap-around, all stamps are cleared).
@@ -149,7 +171,7 @@ mjtNum LocalGeoms::CastRay(const mjModel& m, const mjData& d, const mjtNum pnt[3
     for (const int* id = grid_.CellBegin(ix, iy); id != grid_.CellEnd(ix, iy); ++id) {
       if (ray_stamp_[*id] == ray_count_) continue;
       ray_stamp_[*id] = ray_count_;
-      if (ray_eligible_[*id]) consider(static_geom_[*id]);
+      if (ray_eligible_[*id]) consider(static_geom_[*id], *id);
     }
     const Eigen::Vector2d corner = limits.origin() + r * Eigen::Vector2d(ix, iy);
     const double t_x = u.x() > 0 ? (corner.x() + r - p.x()) / u.x()
@@ -167,23 +189,18 @@ void LocalGeoms::FilterContacts(mjModel* m, const mjtNum* p_root) {
   if (filtering_ && std::hypot(p_root[0] - refresh_x_, p_root[1] - refresh_y_) <= slack_m_) {
     return;
   }
-  // Off: every static geom (the first time) or those enabled until now.
+  // Off: every static geom and site (the first time) or the geoms enabled
+  // until now.
   if (!filtering_) {
-    for (const int geom : static_geom_) {
-      m->geom_contype[geom] = 0;
-      m->geom_conaffinity[geom] = 0;
-    }
+    for (int id = 0; id < static_cast<int>(static_geom_.size()); ++id) SetActive(m, id, false);
+    for (const int site : static_site_) m->site_sameframe[site] = 1;
   }
-  for (const int id : enabled_) {
-    m->geom_contype[static_geom_[id]] = 0;
-    m->geom_conaffinity[static_geom_[id]] = 0;
-  }
+  for (const int id : enabled_) SetActive(m, id, false);
   // On: those within the radius of the robot's root, with their own values.
   enabled_.clear();
   grid_.ForEachNear(Eigen::Vector2d(p_root[0], p_root[1]), contact_radius_m_, [&](int id) {
     if (contype_[id] == 0 && conaffinity_[id] == 0) return;
-    m->geom_contype[static_geom_[id]] = contype_[id];
-    m->geom_conaffinity[static_geom_[id]] = conaffinity_[id];
+    SetActive(m, id, true);
     enabled_.push_back(id);
   });
   filtering_ = true;
@@ -191,10 +208,18 @@ void LocalGeoms::FilterContacts(mjModel* m, const mjtNum* p_root) {
   refresh_y_ = p_root[1];
 }
 
-void LocalGeoms::RestoreContacts(mjModel* m) {
-  for (std::size_t id = 0; id < static_geom_.size(); ++id) {
-    m->geom_contype[static_geom_[id]] = contype_[id];
-    m->geom_conaffinity[static_geom_[id]] = conaffinity_[id];
+void LocalGeoms::RestoreContacts(mjModel* m, mjData* d) {
+  for (int id = 0; id < static_cast<int>(static_geom_.size()); ++id) {
+    SetActive(m, id, true);
+    const int geom = static_geom_[id];
+    std::copy_n(xpos_.data() + 3 * id, 3, d->geom_xpos + 3 * geom);
+    std::copy_n(xmat_.data() + 9 * id, 9, d->geom_xmat + 9 * geom);
+  }
+  for (std::size_t k = 0; k < static_site_.size(); ++k) {
+    const int site = static_site_[k];
+    m->site_sameframe[site] = site_sameframe_[k];
+    std::copy_n(site_xpos_.data() + 3 * k, 3, d->site_xpos + 3 * site);
+    std::copy_n(site_xmat_.data() + 9 * k, 9, d->site_xmat + 9 * site);
   }
   enabled_.clear();
   filtering_ = false;

@@ -34,13 +34,19 @@ namespace mjslam::sim::internal {
 /// moved more than a slack since the last refresh, so that every geom the
 /// robot can reach before the next refresh keeps colliding. MuJoCo then
 /// produces the same contacts (a pair it skips is one that could not touch).
+/// The far primitive geoms and every static site also get sameframe = 1, so
+/// that mj_kinematics copies the world frame into their poses instead of
+/// recomputing them on every step: their poses in mjData are then wrong,
+/// and nothing reads them (they do not collide, the laser reads the static
+/// poses kept at construction, the simulator reads only the robot's sites).
 class LocalGeoms {
  public:
   /// Grids the static geoms of (m, d) (kinematics computed: geom_xpos and
-  /// geom_xmat valid) for rays masked by `geomgroup` (mjNGROUP flags, as
-  /// mj_ray's) and for contacts with the robot `ids`. Reads the robot's
-  /// reach from the current state: the largest distance from the robot's
-  /// root body to the bounding sphere of any of its colliding geoms.
+  /// geom_xmat valid; their poses are kept) for rays masked by `geomgroup`
+  /// (mjNGROUP flags, as mj_ray's) and for contacts with the robot `ids`.
+  /// Reads the robot's reach from the current state: the largest distance
+  /// from the robot's root body to the bounding sphere of any of its
+  /// colliding geoms. Changes nothing in `m` until FilterContacts.
   LocalGeoms(const mjModel& m, const mjData& d, const RobotIndices& ids,
              const mjtByte* geomgroup);
 
@@ -57,15 +63,21 @@ class LocalGeoms {
   /// while the robot is within the slack of the last refresh. `m` must be
   /// the model LocalGeoms was built from.
   void FilterContacts(mjModel* m, const mjtNum* p_root);
-  /// Gives every static world geom back its own contype and conaffinity
-  /// (MuJoCo's all-pairs collision); FilterContacts starts again from
-  /// scratch at its next call.
-  void RestoreContacts(mjModel* m);
+  /// Gives every static world geom back its own contype, conaffinity and
+  /// sameframe, and every static site its sameframe (MuJoCo's all-pairs
+  /// collision, every pose computed), and writes the static geoms' and
+  /// sites' poses kept at construction back into `d` (what mj_kinematics
+  /// would compute for them); FilterContacts starts again from scratch at
+  /// its next call.
+  void RestoreContacts(mjModel* m, mjData* d);
 
  private:
-  // mj_ray's per-geom distance: mesh, height field or primitive.
-  static mjtNum RayGeom(const mjModel& m, const mjData& d, int geom, const mjtNum pnt[3],
-                        const mjtNum vec[3]);
+  // mj_ray's per-geom distance: mesh, height field or primitive (a static
+  // primitive at the pose kept at construction, `box` its id; -1 if none).
+  mjtNum RayGeom(const mjModel& m, const mjData& d, int geom, int box, const mjtNum pnt[3],
+                 const mjtNum vec[3]) const;
+  // Turns box `id`'s contacts and pose computation off or back on.
+  void SetActive(mjModel* m, int id, bool active) const;
 
   BoxGrid grid_;
   // Box id -> geom id; and whether that geom is eligible for rays.
@@ -74,6 +86,16 @@ class LocalGeoms {
   // The geom's own contype and conaffinity (static geoms, by box id).
   std::vector<int> contype_;
   std::vector<int> conaffinity_;
+  std::vector<mjtByte> sameframe_;
+  // The static geoms' poses (3 and 9 numbers per box id), as computed by
+  // MuJoCo at construction.
+  std::vector<mjtNum> xpos_;
+  std::vector<mjtNum> xmat_;
+  // The static sites, their own sameframe and their poses at construction.
+  std::vector<int> static_site_;
+  std::vector<mjtByte> site_sameframe_;
+  std::vector<mjtNum> site_xpos_;
+  std::vector<mjtNum> site_xmat_;
   // Geoms looked at on every ray (planes, height fields, moving geoms).
   std::vector<int> always_ray_;
   // The per-ray stamp of each box (a box spans several cells).

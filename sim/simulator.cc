@@ -390,7 +390,7 @@ LaserScan Simulator::CastLaser(const LaserParams& laser,
 }
 
 void Simulator::SetLocalWorldGeoms(bool on) {
-  if (!on && impl_->local_geoms_on) impl_->local_geoms->RestoreContacts(impl_->m);
+  if (!on && impl_->local_geoms_on) impl_->local_geoms->RestoreContacts(impl_->m, impl_->d);
   impl_->local_geoms_on = on;
 }
 
