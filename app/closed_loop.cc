@@ -132,15 +132,20 @@ void ClosedLoop::SenseWorld() {
   record.command = applied_;
   // The odometry pose as written to trajectory.csv (frame O placed at the
   // start pose in W), so that a replay feeds the filters the same bits.
-  record.X_OR = X_WR0_ * w.odometry.Update(w.simulator.WheelAngles());
+  {
+    const ScopedCpuTimer timer(&cpu_.odometry_s);
+    record.X_OR = X_WR0_ * w.odometry.Update(w.simulator.WheelAngles());
+  }
   record.has_scan = step_ % config_.StepsPerScan() == 0;
   out_.X_WS_true = w.simulator.X_WS();
   if (record.has_scan) {
+    const ScopedCpuTimer timer(&cpu_.laser_s);
     const std::vector<double> jitter = w.laser_noise.DrawAngleOffsets();
     record.scan = w.laser_noise.Apply(w.simulator.CastLaser(config_.laser, jitter));
     record.scan.t_s = t;
-    w.coverage->Observe(out_.X_WS_true, record.scan);
   }
+  const ScopedCpuTimer coverage_timer(&cpu_.coverage_s);
+  if (record.has_scan) w.coverage->Observe(out_.X_WS_true, record.scan);
   const double explored = w.coverage->ExploredFraction();
   if (!w.t90 && explored >= 0.90) w.t90 = t;
   if (!w.t99 && explored >= 0.99) w.t99 = t;
@@ -182,12 +187,14 @@ void ClosedLoop::ReadRecording() {
 }
 
 void ClosedLoop::RunFilters() {
+  const ScopedCpuTimer timer(&cpu_.filters_s);
   slam_->Step(out_.record);
   const Pose2& X_WR = out_.row.X_WR_true;
   out_.row.filters = slam_->Rows(Pose2(X_WR.x, X_WR.y, X_WR.theta));
 }
 
 void ClosedLoop::Drive() {
+  const ScopedCpuTimer timer(&cpu_.explorer_s);
   if (world_) {
     DriveInWorld();
   } else {
@@ -236,6 +243,7 @@ void ClosedLoop::Advance() {
   finished_ = out_.finished;
   if (world_ && !finished_ && step_ < last_step_) {
     World& w = *world_;
+    const ScopedCpuTimer timer(&cpu_.physics_s);
     w.simulator.Advance(dt_s_);
     const int contacts = w.simulator.CountRobotWorldContacts();
     if (contacts > 0) ++w.contact_steps;

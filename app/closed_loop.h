@@ -4,6 +4,7 @@
 #include <optional>
 #include <string>
 
+#include "app/cpu_profile.h"
 #include "app/run_config.h"
 #include "app/slam_pair.h"
 #include "common/records.h"
@@ -77,6 +78,10 @@ class ClosedLoop {
   /// exploration, termination (`interrupted` when `interrupted`), and each
   /// filter's end state against the current true pose.
   rundir::RunSummary Summary(bool interrupted) const;
+  /// CPU seconds spent so far in each phase of the steps (the physics, the
+  /// laser, odometry, coverage, the filters, the driver); the files, video
+  /// and total are the caller's to fill in.
+  const PhaseCpu& cpu() const { return cpu_; }
 
  private:
   struct World;  // the simulated world: simulator, noise, odometry, driver, coverage
@@ -107,6 +112,7 @@ class ClosedLoop {
   Twist2 applied_;
   bool finished_ = false;
   LoopStep out_;
+  PhaseCpu cpu_;
 };
 
 }  // namespace mjslam::app

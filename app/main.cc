@@ -12,6 +12,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "app/cpu_profile.h"
 #include "app/evaluate.h"
 #include "app/render_run.h"
 #include "app/replay.h"
@@ -68,6 +69,7 @@ struct RunCommand {
   bool quiet = false;
   bool no_render = false;
   bool no_evaluate = false;
+  bool profile = false;
 };
 
 CLI::App* AddRun(CLI::App* cli, RunCommand* c) {
@@ -84,6 +86,9 @@ CLI::App* AddRun(CLI::App* cli, RunCommand* c) {
   run->add_flag("--no-render", c->no_render, "Do not render at the end, whatever render.enabled says");
   run->add_flag("--no-evaluate", c->no_evaluate,
                 "Do not evaluate at the end (ground_truth_map.csv, metrics in summary.json)");
+  run->add_flag("--profile", c->profile,
+                "Print the CPU seconds of each phase of the run (physics, laser, filters, ...) "
+                "and simulated seconds per CPU second");
   return run;
 }
 
@@ -114,6 +119,9 @@ int RunMain(const CLI::App& run, RunCommand c, const std::string& command_line) 
   const RunResult result = RunSimulation(config, options);
   std::fprintf(stderr, "%s: %s after %d steps (%.1f s simulated)\n", options.out_dir.c_str(),
                result.status.c_str(), result.steps, result.sim_time_s);
+  if (c.profile && result.sim_time_s > 0.0) {
+    std::printf("%s", PhaseCpuReport(result.cpu, result.sim_time_s, ProcessCpuSeconds()).c_str());
+  }
   if (result.status != "completed") return 130;
   if (!c.no_evaluate) EvaluateRunDirectory(options.out_dir, EvaluateOptions{});
   if (render) {

@@ -97,6 +97,7 @@ std::optional<std::string> RangeNoiseNote(const RunConfig& config) {
 }
 
 RunResult RunSimulation(const RunConfig& config, const RunOptions& options) {
+  const double start_cpu_s = ThreadCpuSeconds();
   config.ValidateOrThrow();
   const std::string& dir = options.out_dir;
   // The manifest reads (hashes) the world and robot files: a missing one is
@@ -124,11 +125,15 @@ RunResult RunSimulation(const RunConfig& config, const RunOptions& options) {
         break;
       }
       const LoopStep& step = loop.Step();
-      files.Add(step, loop.explorer());
+      {
+        const ScopedCpuTimer timer(&result.cpu.files_s);
+        files.Add(step, loop.explorer());
+      }
       result.steps = step.index + 1;
       result.sim_time_s = step.record.t_s;
       progress.Update(step.index);
       if (video) {
+        const ScopedCpuTimer timer(&result.cpu.video_s);
         video->Step(step.record.t_s, step.row.X_WR_true, loop.slam(),
                     step.record.has_scan ? &step.record.scan : nullptr, step.X_WS_true, loop.explorer());
       }
@@ -144,6 +149,13 @@ RunResult RunSimulation(const RunConfig& config, const RunOptions& options) {
     // A fresh summary for this run (one from a run before is replaced);
     // evaluation merges its own keys into it.
     rundir::WriteSummary(dir, rundir::ToJson(loop.Summary(result.status == "interrupted")));
+    const PhaseCpu& loop_cpu = loop.cpu();
+    result.cpu.physics_s = loop_cpu.physics_s;
+    result.cpu.laser_s = loop_cpu.laser_s;
+    result.cpu.odometry_s = loop_cpu.odometry_s;
+    result.cpu.coverage_s = loop_cpu.coverage_s;
+    result.cpu.filters_s = loop_cpu.filters_s;
+    result.cpu.explorer_s = loop_cpu.explorer_s;
   } catch (const std::exception& error) {
     record_progress();
     manifest.Fail(error.what());
@@ -151,6 +163,7 @@ RunResult RunSimulation(const RunConfig& config, const RunOptions& options) {
   }
   record_progress();
   manifest.Finish(result.status);
+  result.cpu.run_total_s = ThreadCpuSeconds() - start_cpu_s;
   return result;
 }
 

@@ -4,6 +4,7 @@
 #include <optional>
 #include <string>
 
+#include "app/cpu_profile.h"
 #include "app/run_config.h"
 
 namespace mjslam::app {
@@ -35,6 +36,8 @@ struct RunResult {
   /// second of the wall time spent rendering and encoding them.
   int video_frames = 0;
   double video_fps = 0.0;
+  /// CPU seconds by phase of the run (PhaseCpu; `mjslam run --profile`).
+  PhaseCpu cpu;
 };
 
 /// Runs one closed-loop simulation (ClosedLoop): MuJoCo steps the robot, the

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "common/check.h"
 
@@ -35,11 +36,31 @@ TrueCoverage::TrueCoverage(const std::vector<sim::ObstacleFootprint>& obstacles,
   const int width = limits_.width();
   const int height = limits_.height();
 
-  // Clearance of every cell centre.
-  Grid2<double> clearance(limits_);
-  for (int j = 0; j < height; ++j) {
-    for (int i = 0; i < width; ++i) {
-      clearance(i, j) = sim::DistanceToObstacles(limits_.CellCenter(i, j), obstacles);
+  // Clearance of the cell centres, where it matters: only whether it is at
+  // least robot_radius_m and more than kFreeMargin is used below, so each
+  // obstacle sets the cells within robot_radius_m of its bounding box (the
+  // exact distance, the smallest over the obstacles near the cell) and every
+  // other cell keeps +infinity. The cost grows with the obstacles' area, not
+  // with (grid area) x (number of obstacles).
+  Grid2<double> clearance(limits_, std::numeric_limits<double>::infinity());
+  for (const sim::ObstacleFootprint& o : obstacles) {
+    // The footprint's axis-aligned half extents in W, widened.
+    Eigen::Vector2d half = Eigen::Vector2d::Constant(o.radius_m);
+    if (o.shape == sim::ObstacleFootprint::Shape::kRectangle) {
+      const double c = std::abs(std::cos(o.X_WO.theta));
+      const double s = std::abs(std::sin(o.X_WO.theta));
+      half = Eigen::Vector2d(c * o.half_extents_m.x() + s * o.half_extents_m.y(),
+                             s * o.half_extents_m.x() + c * o.half_extents_m.y());
+    }
+    half.array() += robot_radius_m + cell_m;
+    const Eigen::Vector2d p_WO(o.X_WO.x, o.X_WO.y);
+    const Eigen::Vector2i lo_cell = limits_.CellOf(p_WO - half);
+    const Eigen::Vector2i hi_cell = limits_.CellOf(p_WO + half);
+    for (int j = std::max(0, lo_cell.y()); j <= std::min(height - 1, hi_cell.y()); ++j) {
+      for (int i = std::max(0, lo_cell.x()); i <= std::min(width - 1, hi_cell.x()); ++i) {
+        const double distance = sim::DistanceToFootprint(limits_.CellCenter(i, j), o);
+        clearance(i, j) = std::min(clearance(i, j), distance);
+      }
     }
   }
 

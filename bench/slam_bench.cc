@@ -2,7 +2,9 @@
 // 25 to 400 features, one sparse correction, the selection criterion of 20
 // candidates, a whole classical and a whole selective step with 15 matched
 // observations, a dense (I - K H) P reference, and one pass over P (its sum
-// and a copy) to compare against; plus feature extraction on one scan.
+// and a copy) to compare against; plus feature extraction on one scan; and
+// the classical step against (number of corrections) x (one pass over P),
+// measured side by side at 600 features (BM_ClassicalStepOverPasses).
 //
 //   build-ekf/bench/mjslam_bench --benchmark_min_time=0.2
 
@@ -16,6 +18,7 @@
 #include <benchmark/benchmark.h>
 
 #include "common/angles.h"
+#include "common/cpu_time.h"
 #include "common/laser_scan.h"
 #include "common/pose2.h"
 #include "common/records.h"
@@ -232,6 +235,40 @@ BENCHMARK(BM_ClassicalStep)->Apply(MapSizes)->Unit(benchmark::kMicrosecond);
 
 void BM_SelectiveStep(benchmark::State& state) { StepBenchmark(state, CorrectionMode::kSelective); }
 BENCHMARK(BM_SelectiveStep)->Apply(MapSizes)->Unit(benchmark::kMicrosecond);
+
+// The classical step against its floor: each iteration times one classical
+// step (15 matched observations, each a sequential correction) and one read
+// pass over P (its sum), alternately, so both see the same machine state,
+// in thread CPU time (other jobs on the machine do not count).
+// Counters: the mean of each, the corrections per step, and
+// ratio = step / (corrections x pass); the target is ratio <= 2.
+void BM_ClassicalStepOverPasses(benchmark::State& state) {
+  EkfSlam filter = MakeFilter(static_cast<int>(state.range(0)), CorrectionMode::kClassical);
+  Rng rng(11);
+  const ScanFeatures features = ObservationsOf(filter, kMatchedPerStep, &rng);
+  SensorRecord record;
+  record.dt_s = 0.1;
+  StepReport report;
+  double step_s = 0.0;
+  double pass_s = 0.0;
+  for (auto _ : state) {
+    const double t0 = ThreadCpuSeconds();
+    report = filter.Step(record, &features);
+    benchmark::ClobberMemory();
+    const double t1 = ThreadCpuSeconds();
+    benchmark::DoNotOptimize(filter.slam_state().covariance().sum());
+    const double t2 = ThreadCpuSeconds();
+    step_s += t1 - t0;
+    pass_s += t2 - t1;
+  }
+  const double n = static_cast<double>(state.iterations());
+  ReportSize(state, filter.slam_state());
+  state.counters["step_us"] = 1e6 * step_s / n;
+  state.counters["pass_us"] = 1e6 * pass_s / n;
+  state.counters["corrections"] = report.num_updated;
+  state.counters["ratio"] = step_s / (report.num_updated * pass_s);
+}
+BENCHMARK(BM_ClassicalStepOverPasses)->Arg(400)->Arg(600)->Unit(benchmark::kMicrosecond);
 
 // A SICK-like scan (181 beams over 180 degrees, 1 degree apart, 30 m) from
 // inside a 10 x 8 m room with a 2 x 2 m pillar, range noise 5 mm.

@@ -9,6 +9,7 @@
 
 #include "common/angles.h"
 #include "sim/diff_drive.h"
+#include "sim/local_geoms.h"
 #include "sim/scene_model.h"
 
 namespace mjslam::sim {
@@ -64,6 +65,11 @@ void CheckWheelGainIsStable(const Scene& scene, const SimParams& sim) {
   }
 }
 
+// The laser's geom groups for mj_ray: every group but the robot's.
+void LaserGeomGroups(mjtByte groups[mjNGROUP]) {
+  for (int group = 0; group < mjNGROUP; ++group) groups[group] = group != kRobotGeomGroup;
+}
+
 // Validates the params before loading the files (the order of the checks of
 // the path constructor).
 Scene ValidatedScene(const std::string& world_path, const std::string& robot_model_path,
@@ -97,6 +103,10 @@ struct Simulator::Impl {
   double requested_time_s = 0.0;
   long long steps = 0;
   double rest_height_m = 0.0;
+  // The static world geoms in a grid (contacts near the robot, beams along
+  // their cells); used while local_geoms_on.
+  std::optional<internal::LocalGeoms> local_geoms;
+  bool local_geoms_on = true;
 
   bool IsRobotGeom(int geom) const { return internal::IsRobotGeom(*m, ids, geom); }
 
@@ -209,6 +219,8 @@ void Simulator::Impl::Step() {
     if (applied == torque || error * torque < 0.0) speed_error_integral_rad[i] = integral;
     d->ctrl[actuator] = applied;
   }
+  // Only the world geoms within the robot's reach collide (same contacts).
+  if (local_geoms_on) local_geoms->FilterContacts(m, d->qpos + ids.root_qposadr);
   auto step = [this] { mj_step(m, d); };
   const std::string problem = TrapMujocoErrors(step);
   if (!problem.empty()) {
@@ -261,6 +273,9 @@ Simulator::Simulator(Scene scene, const SimParams& sim, const RobotParams& robot
   r.data = internal::MakeData(*r.m, "starting the physics");
   r.d = r.data.get();
   r.Place(X_WR_start.value_or(r.scene.StartPose()));
+  mjtByte laser_groups[mjNGROUP];
+  LaserGeomGroups(laser_groups);
+  r.local_geoms.emplace(*r.m, *r.d, r.ids, laser_groups);
   r.Settle();
 }
 
@@ -347,7 +362,9 @@ LaserScan Simulator::CastLaser(const LaserParams& laser,
 
   // Every geom group but the robot's; static (world body) geoms included.
   mjtByte geom_groups[mjNGROUP];
-  for (int group = 0; group < mjNGROUP; ++group) geom_groups[group] = group != kRobotGeomGroup;
+  LaserGeomGroups(geom_groups);
+  const internal::LocalGeoms* local =
+      impl_->local_geoms_on ? &*impl_->local_geoms : nullptr;
   const Pose2 X_WS = this->X_WS();
   const mjtNum origin[3] = {X_WS.x, X_WS.y, d->site_xpos[3 * impl_->ids.laser_site + 2]};
   const double* offsets = beam_angle_offsets_rad.empty() ? nullptr : beam_angle_offsets_rad.data();
@@ -360,7 +377,9 @@ LaserScan Simulator::CastLaser(const LaserParams& laser,
       const double bearing_W = X_WS.theta + scan.BeamAngle(i) + offset;
       const mjtNum direction[3] = {std::cos(bearing_W), std::sin(bearing_W), 0.0};
       int geom = -1;
-      const mjtNum distance = mj_ray(m, d, origin, direction, geom_groups, 1, -1, &geom);
+      const mjtNum distance =
+          local != nullptr ? local->CastRay(*m, *d, origin, direction, laser.max_range_m)
+                           : mj_ray(m, d, origin, direction, geom_groups, 1, -1, &geom);
       if (distance >= 0.0 && distance < laser.max_range_m) {
         ranges[i] = distance;
         has_return[i] = 1;
@@ -369,6 +388,13 @@ LaserScan Simulator::CastLaser(const LaserParams& laser,
   });
   return scan;
 }
+
+void Simulator::SetLocalWorldGeoms(bool on) {
+  if (!on && impl_->local_geoms_on) impl_->local_geoms->RestoreContacts(impl_->m, impl_->d);
+  impl_->local_geoms_on = on;
+}
+
+bool Simulator::local_world_geoms() const { return impl_->local_geoms_on; }
 
 int Simulator::CountRobotWorldContacts() const { return impl_->CountRobotWorldContacts(); }
 

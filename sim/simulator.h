@@ -101,6 +101,19 @@ class Simulator {
   LaserScan CastLaser(const LaserParams& laser,
                       const std::vector<double>& beam_angle_offsets_rad = {}) const;
 
+  /// Whether contacts and laser beams consider only the world geoms that
+  /// matter (true, the default) or every geom (false: MuJoCo's all-pairs
+  /// collision and mj_ray, as MuJoCo alone does; for checks and benchmarks).
+  /// Either way the results are the same, bit for bit: with it on, the
+  /// static world geoms farther than the robot can reach before the next
+  /// refresh do not collide (their contype and conaffinity are 0 in the
+  /// simulator's model copy), and each beam tests, with mj_ray's own per-geom
+  /// functions, only the static geoms listed in the cells of a 1 m grid that
+  /// it crosses, up to its first hit (sim/README.md, "Local contacts and
+  /// beams"). Can be switched at any time.
+  void SetLocalWorldGeoms(bool on);
+  bool local_world_geoms() const;
+
   /// Number of contacts between robot geoms and world geoms other than
   /// planes (the floor): 0 unless the robot touches an obstacle.
   int CountRobotWorldContacts() const;

@@ -21,7 +21,7 @@ const std::set<std::string> kCodeFolders = {"common", "config", "sim",     "slam
 // What each folder may include from the project and from outside.
 struct Rule {
   std::set<std::string> project;  // project folders it may include
-  bool mujoco = false;  // also sim/scene_model.h, sim's internal header with MuJoCo types
+  bool mujoco = false;  // also sim/scene_model.h and sim/local_geoms.h, sim's internal headers with MuJoCo types
   bool yaml = false;
   bool gl = false;
   bool files_and_printing = true;  // <fstream>, <iostream>
@@ -55,7 +55,9 @@ std::vector<std::string> Violations(const std::string& text, const Rule& rule) {
     const bool nested = header.find('/') != std::string::npos;
     if (nested && kCodeFolders.count(top) > 0 && rule.project.count(top) == 0) {
       found.push_back(header);
-    } else if ((top == "mujoco" || header == "sim/scene_model.h") && !rule.mujoco) {
+    } else if ((top == "mujoco" || header == "sim/scene_model.h" ||
+                header == "sim/local_geoms.h") &&
+               !rule.mujoco) {
       found.push_back(header);
     } else if (top == "yaml-cpp" && !rule.yaml) {
       found.push_back(header);
@@ -80,6 +82,7 @@ TEST(LayeringTest, DetectsForbiddenIncludes) {
   // header; renders/ may use both.
   const std::string internal = "#include \"sim/scene_model.h\"\n#include \"sim/scene.h\"\n";
   EXPECT_EQ(Violations(internal, RuleFor("app")).size(), 1u);
+  EXPECT_EQ(Violations("#include \"sim/local_geoms.h\"\n", RuleFor("app")).size(), 1u);
   EXPECT_TRUE(Violations(internal, RuleFor("renders")).empty());
   // rundir/ may write files but knows nothing of MuJoCo, YAML, the filters
   // or the program.

@@ -1,0 +1,56 @@
+#pragma once
+
+#include <string>
+
+#include "common/cpu_time.h"
+
+namespace mjslam::app {
+
+/// CPU seconds a simulated run spent in each of its phases, as `mjslam run
+/// --profile` prints them. Measured with ThreadCpuSeconds()
+/// (common/cpu_time.h) around each phase of every step (a few clock reads
+/// per step). What is not in a phase (setup, the loop's own bookkeeping, the
+/// maps and summary at the end) is the rest of RunSimulation's CPU time.
+struct PhaseCpu {
+  /// The physics: Simulator::Advance (mj_step) and the contact count.
+  double physics_s = 0.0;
+  /// The laser: the exact cast (Simulator::CastLaser) and its noise.
+  double laser_s = 0.0;
+  /// Wheel odometry from the simulator's wheel angles.
+  double odometry_s = 0.0;
+  /// The explored fraction: TrueCoverage::Observe and ExploredFraction.
+  double coverage_s = 0.0;
+  /// Both filters' own steps (SlamPair::Step) and their trajectory.csv
+  /// columns.
+  double filters_s = 0.0;
+  /// The driver: the explorer (or the tour) and SetCommand.
+  double explorer_s = 0.0;
+  /// The rows of trajectory.csv, scans.csv and explorer.csv.
+  double files_s = 0.0;
+  /// The live video (render.video).
+  double video_s = 0.0;
+  /// The whole of RunSimulation (setup, every step, the files at the end).
+  double run_total_s = 0.0;
+};
+
+/// Adds the calling thread's CPU time from construction to destruction to
+/// *total_s.
+class ScopedCpuTimer {
+ public:
+  explicit ScopedCpuTimer(double* total_s) : total_s_(total_s), start_s_(ThreadCpuSeconds()) {}
+  ~ScopedCpuTimer() { *total_s_ += ThreadCpuSeconds() - start_s_; }
+  ScopedCpuTimer(const ScopedCpuTimer&) = delete;
+  ScopedCpuTimer& operator=(const ScopedCpuTimer&) = delete;
+
+ private:
+  double* total_s_;
+  double start_s_;
+};
+
+/// The text `mjslam run --profile` prints: each phase's CPU seconds and
+/// share, the rest of the run, the process's CPU time (`process_cpu_s`,
+/// loading included), and simulated seconds per CPU second for the run
+/// and for the run without the filters' own steps. `sim_time_s` > 0.
+std::string PhaseCpuReport(const PhaseCpu& cpu, double sim_time_s, double process_cpu_s);
+
+}  // namespace mjslam::app
