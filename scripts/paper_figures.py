@@ -20,6 +20,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 COLORS = {"truth": "#0d0d0d", "classical": "#ff8000", "selective": "#0066ff"}
 FILTERS = ("classical", "selective")
 DPI = 100
+# The first filter drawn wider, so that it shows where the two curves coincide.
+WIDTHS = {"classical": 2.6, "selective": 1.2}
 
 
 def read_csv(path):
@@ -145,7 +147,7 @@ def fig4c_processing(traj, path, label, cost):
     t = traj["t"]
     fig, ax = plt.subplots(figsize=(8, 4.5))
     for f in FILTERS:
-        ax.plot(t, accumulate(modelled_processing(traj, f, cost)), color=COLORS[f], lw=1.5,
+        ax.plot(t, accumulate(modelled_processing(traj, f, cost)), color=COLORS[f], lw=WIDTHS[f],
                 label=f)
     ax.set_xlabel("time (s)")
     ax.set_ylabel("accumulated processing time (s)")
@@ -164,8 +166,8 @@ def fig4d_open_loop(traj, path, label, dt):
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.5))
     for f in FILTERS:
         whole, beyond = command_timeline(traj, f, dt)
-        axes[0].plot(t, whole, color=COLORS[f], lw=1.5, label=f)
-        axes[1].plot(t, beyond, color=COLORS[f], lw=1.5, label=f)
+        axes[0].plot(t, whole, color=COLORS[f], lw=WIDTHS[f], label=f)
+        axes[1].plot(t, beyond, color=COLORS[f], lw=WIDTHS[f], label=f)
     axes[0].set_title("whole period of every held command (the paper's count)")
     axes[1].set_title("period beyond one control step (f_open_loop)")
     for ax in axes:
@@ -330,12 +332,12 @@ def fig4cd_scale(runs, path, cost, dt):
             s = scale_series(traj, f, cost, dt)
             pts = [(n, p) for n, p, d in zip(s["nfeat"], s["period"], s["processed"]) if d == 1]
             axes[0][0].plot([p[0] for p in pts], [p[1] for p in pts], color=COLORS[f], ls=ls,
-                            lw=1.0, marker=".", ms=2, label="%s, %s" % (f, label))
-            axes[0][1].plot(s["nfeat"], s["processing"], color=COLORS[f], ls=ls, lw=1.3,
+                            lw=WIDTHS[f] * 0.6, marker=".", ms=2, label="%s, %s" % (f, label))
+            axes[0][1].plot(s["nfeat"], s["processing"], color=COLORS[f], ls=ls, lw=WIDTHS[f],
                             label="%s, %s" % (f, label))
-            axes[1][0].plot(s["nfeat"], s["skipped"], color=COLORS[f], ls=ls, lw=1.3,
+            axes[1][0].plot(s["nfeat"], s["skipped"], color=COLORS[f], ls=ls, lw=WIDTHS[f],
                             label="%s, %s" % (f, label))
-            axes[1][1].plot(s["nfeat"], s["open_loop"], color=COLORS[f], ls=ls, lw=1.3,
+            axes[1][1].plot(s["nfeat"], s["open_loop"], color=COLORS[f], ls=ls, lw=WIDTHS[f],
                             label="%s, %s" % (f, label))
     axes[0][0].axhline(0.7, color="0.4", lw=0.8, ls=":")
     axes[0][0].axhline(0.2, color="0.4", lw=0.8, ls=":")
