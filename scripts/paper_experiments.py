@@ -25,8 +25,9 @@ published, docs/method.md):
    "claim | paper | default model | paper model", also printed) and DIR/claims.json.
 
 Then, once (issue 12 item 5, Figs. 4(c)-(d) at scale): one `mjslam run` per --scale-worlds world
-with configs/default.yaml, `slam.timing: realtime` and the world's tour (control.driver: tour),
--> DIR/scale/<world>; fig4cd_scale.png (period, processing, skipped scans and open loop against
+with configs/default.yaml, `slam.timing: realtime` and the world's tour once (control.driver:
+tour, driver.loop: false; not evaluated) -> DIR/scale/<world>, read up to the tour's last command (the robot then stands until the time
+limit); fig4cd_scale.png (period, processing, skipped scans and open loop against
 map size per filter) and the table "first step where the classical period reaches 0.7 s".
 
 Figures (M = default or paper): fig3_pose_errors_M.png (corridor, seed run.seed),
@@ -390,23 +391,25 @@ def draw_model_figures(res, fig_dir, points_margin_m=0.5):
 def scale_study(args, mjslam, fig_dir):
     """One realtime tour per world; returns the table lines and draws fig4cd_scale.png."""
     runs, lines = [], []
-    lines.append("| world | steps | final map classical / selective | scans skipped classical / "
+    lines.append("| world | driven (run's end) | final map classical / selective | scans skipped classical / "
                  "selective | open loop (whole periods) s | first step with classical period "
                  ">= 0.7 s: t, map sizes, selective period | first step with selective period "
                  "> 0.2 s: t, selective map |")
     lines.append("|---|---|---|---|---|---|---|")
-    for world in args.scale_worlds:
+    for item in args.scale_worlds:
+        world, _, seconds = item.partition(":")
+        duration = float(seconds) if seconds else args.scale_duration
         name = os.path.splitext(os.path.basename(world))[0]
         out = os.path.join(args.out, "scale", name)
         if not os.path.exists(os.path.join(out, "summary.json")):
             os.makedirs(os.path.dirname(out), exist_ok=True)
             command = [mjslam, "run", "--config", "configs/default.yaml", "--world", world,
                        "--set", "slam.timing=realtime", "--set", "control.driver=tour",
-                       "--set", "render.enabled=false", "--no-render", "--quiet", "--out", out]
-            if args.scale_duration is not None:
-                command += ["--duration", str(args.scale_duration)]
+                       "--set", "driver.loop=false", "--set", "render.enabled=false",
+                       "--no-render", "--no-evaluate", "--quiet", "--out", out]
+            command += ["--duration", str(duration)]
             run_command(command, out + ".log")
-        traj = figs.read_csv(os.path.join(out, "trajectory.csv"))
+        traj = figs.until_last_motion(figs.read_csv(os.path.join(out, "trajectory.csv")))
         cost, dt = timing_of(out)
         runs.append((name, traj))
         summary = read_json(os.path.join(out, "summary.json"))
@@ -421,10 +424,10 @@ def scale_study(args, mjslam, fig_dir):
             fmt(traj["selective_period"][first_c])) if first_c is not None else "never")
         cell_s = ("t %s s, map %d" % (fmt(t[first_s]), traj["selective_nfeat"][first_s])
                   if first_s is not None else "never")
-        fs = summary["filters"]
-        lines.append("| %s | %d | %d / %d | %s / %s | %s / %s | %s | %s |" % (
-            name, len(t), fs["classical"]["num_features"], fs["selective"]["num_features"],
-            fs["classical"].get("scans_skipped"), fs["selective"].get("scans_skipped"),
+        skipped = {f: figs.scale_series(traj, f, cost, dt)["skipped"][-1] for f in FILTERS}
+        lines.append("| %s | %s s (%s) | %d / %d | %d / %d | %s / %s | %s | %s |" % (
+            name, fmt(t[-1]), summary["run"]["termination_reason"], traj["classical_nfeat"][-1],
+            traj["selective_nfeat"][-1], skipped["classical"], skipped["selective"],
             fmt(whole["classical"]), fmt(whole["selective"]), cell_c, cell_s))
     if runs:
         figs.fig4cd_scale(runs, os.path.join(fig_dir, "fig4cd_scale.png"), cost, dt)
@@ -450,10 +453,11 @@ def main():
                         help="realisations per #E of the divergence studies [100]")
     parser.add_argument("--models", nargs="+", default=["default", "paper"],
                         choices=["default", "paper"], help="configs/M.yaml [default paper]")
-    parser.add_argument("--scale-worlds", nargs="*", default=["worlds/office.xml"],
-                        help="worlds of the realtime study at scale [worlds/office.xml]")
-    parser.add_argument("--scale-duration", type=float, default=None,
-                        help="time limit of each scale run, s [run.duration_s of the config]")
+    parser.add_argument("--scale-worlds", nargs="*", default=["worlds/office.xml:300"],
+                        help="worlds of the realtime study at scale, each WORLD or WORLD:SECONDS "
+                        "(its time limit) [worlds/office.xml:300]")
+    parser.add_argument("--scale-duration", type=float, default=3000.0,
+                        help="time limit of a scale run without its own, s [3000]")
     parser.add_argument("--mjslam", default="build/mjslam", help="the program [build/mjslam]")
     args = parser.parse_args()
 

@@ -16,6 +16,7 @@ import matplotlib
 
 matplotlib.use("Agg")  # no display
 import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.ticker  # noqa: E402
 
 COLORS = {"truth": "#0d0d0d", "classical": "#ff8000", "selective": "#0066ff"}
 FILTERS = ("classical", "selective")
@@ -304,6 +305,14 @@ def anees_plot(nees, path, label):
 # ---------------------------------------------------------------------------------------------
 # Figs. 4(c)-(d) at scale: period, processing, skipped scans and open loop against map size.
 
+def until_last_motion(traj):
+    """The trajectory up to the last step with a non-zero command: a tour that has ended leaves
+    the robot standing until the time limit, with nothing changing but the clock."""
+    last = max((s for s, (v, w) in enumerate(zip(traj["cmd_v"], traj["cmd_w"]))
+                if v != 0.0 or w != 0.0), default=len(traj["t"]) - 1)
+    return {k: v[:last + 2] for k, v in traj.items()}
+
+
 def scale_series(traj, name, cost, dt):
     """Per step of one filter: map size, its command period on processed steps, accumulated
     modelled processing, scans skipped so far, open-loop time so far (whole periods)."""
@@ -323,33 +332,44 @@ def scale_series(traj, name, cost, dt):
 
 def fig4cd_scale(runs, path, cost, dt):
     """Figs. 4(c)-(d) at scale: for each (label, trajectory) of `runs`, each filter's command period
-    (processed steps), accumulated processing time (modelled), skipped scans and open-loop time
-    (whole periods), all against the filter's map size."""
-    fig, axes = plt.subplots(2, 2, figsize=(12, 8.5))
+    against its map size (processed steps), and against time its map size, command period,
+    accumulated processing time (modelled), skipped scans and open-loop time (whole periods)."""
+    fig, axes = plt.subplots(2, 3, figsize=(16, 9))
     styles = ("-", "--", ":", "-.")
-    for (label, traj), ls in zip(runs, styles):
+    markers = ("o", "x", "+", "^")
+    for (label, traj), ls, marker in zip(runs, styles, markers):
+        t = traj["t"]
         for f in FILTERS:
             s = scale_series(traj, f, cost, dt)
-            pts = [(n, p) for n, p, d in zip(s["nfeat"], s["period"], s["processed"]) if d == 1]
-            axes[0][0].plot([p[0] for p in pts], [p[1] for p in pts], color=COLORS[f], ls=ls,
-                            lw=WIDTHS[f] * 0.6, marker=".", ms=2, label="%s, %s" % (f, label))
-            axes[0][1].plot(s["nfeat"], s["processing"], color=COLORS[f], ls=ls, lw=WIDTHS[f],
-                            label="%s, %s" % (f, label))
-            axes[1][0].plot(s["nfeat"], s["skipped"], color=COLORS[f], ls=ls, lw=WIDTHS[f],
-                            label="%s, %s" % (f, label))
-            axes[1][1].plot(s["nfeat"], s["open_loop"], color=COLORS[f], ls=ls, lw=WIDTHS[f],
-                            label="%s, %s" % (f, label))
-    axes[0][0].axhline(0.7, color="0.4", lw=0.8, ls=":")
-    axes[0][0].axhline(0.2, color="0.4", lw=0.8, ls=":")
-    titles = ("command period (s), processed steps; dotted: the paper's 0.2 and 0.7 s",
-              "accumulated processing time (s), modelled",
+            name = "%s, %s" % (f, label)
+            pts = [(n, p, tt) for n, p, d, tt in zip(s["nfeat"], s["period"], s["processed"], t)
+                   if d == 1]
+            axes[0][0].scatter([p[0] for p in pts], [p[1] for p in pts], color=COLORS[f], s=6,
+                               marker=marker, lw=0.6, alpha=0.6, label=name)
+            axes[0][1].plot(t, s["nfeat"], color=COLORS[f], ls=ls, lw=WIDTHS[f], label=name)
+            axes[0][2].plot([p[2] for p in pts], [p[1] for p in pts], color=COLORS[f], ls=ls,
+                            lw=WIDTHS[f] * 0.5, label=name)
+            axes[1][0].plot(t, s["processing"], color=COLORS[f], ls=ls, lw=WIDTHS[f], label=name)
+            axes[1][1].plot(t, s["skipped"], color=COLORS[f], ls=ls, lw=WIDTHS[f], label=name)
+            axes[1][2].plot(t, s["open_loop"], color=COLORS[f], ls=ls, lw=WIDTHS[f], label=name)
+    for ax in (axes[0][0], axes[0][2]):
+        ax.axhline(0.7, color="0.4", lw=0.8, ls=":")
+        ax.axhline(0.2, color="0.4", lw=0.8, ls=":")
+        ax.set_yscale("log")
+        ax.set_yticks([0.1, 0.2, 0.5, 0.7, 1, 2, 5, 10])
+        ax.get_yaxis().set_major_formatter(matplotlib.ticker.FormatStrFormatter("%g"))
+    titles = ("command period (s) against the filter's map size\n(processed steps; dotted: the "
+              "paper's 0.2 and 0.7 s)", "map size (features)",
+              "command period (s), processed steps", "accumulated processing time (s), modelled",
               "scans skipped so far", "accumulated open-loop time (s), whole periods")
     for ax, title in zip([a for row in axes for a in row], titles):
         ax.set_title(title, fontsize=10)
-        ax.set_xlabel("the filter's map size (features)")
-        ax.grid(True, alpha=0.3)
-    axes[0][0].legend(fontsize=7, loc="upper left")
-    fig.suptitle("Figs. 4(c)-(d) (paper) at scale: slam.timing realtime, cost model b = %g s, "
-                 "k = %g s per update per n²" % (cost[0], cost[1]))
+        ax.set_xlabel("time (s)")
+        ax.grid(True, alpha=0.3, which="both")
+    axes[0][0].set_xlabel("the filter's map size (features)")
+    axes[0][0].legend(fontsize=7, loc="upper left", markerscale=2)
+    axes[0][1].legend(fontsize=7, loc="lower right")
+    fig.suptitle("Figs. 4(c)-(d) (paper) at scale: slam.timing realtime, periods and processing "
+                 "from the cost model (b = %g s, k = %g s per update per n²)" % (cost[0], cost[1]))
     fig.tight_layout()
     save(fig, path)
