@@ -141,7 +141,7 @@ def plot_explored(traj, path):
     save(fig, path)
 
 
-def plot_nees(nees, path):
+def plot_nees(nees, path, where=""):
     """Average NEES with its chi-square bounds over time (a consistency test; not a figure of the
     paper)."""
     fig, ax = plt.subplots(figsize=(8, 4))
@@ -159,7 +159,7 @@ def plot_nees(nees, path):
     ax.yaxis.set_major_formatter(plain)
     ax.yaxis.set_minor_formatter(plain)
     ax.tick_params(axis="y", which="minor", labelsize=7)
-    ax.set_title(f"Average NEES over {int(max(n_runs)) if n_runs else 0} runs "
+    ax.set_title(f"Average NEES over {int(max(n_runs)) if n_runs else 0} runs{where}\n"
                  "(a consistency test, not a figure of the paper)")
     ax.grid(True, alpha=0.3, which="both")
     ax.legend(loc="best")

@@ -381,8 +381,8 @@ def draw_model_figures(res, fig_dir, points_margin_m=0.5):
                            "Fig. 7 (paper): divergence of each map to the truth against #E, %s"
                            % where)
     nees = figs.read_csv(os.path.join(res["dir"], "corridor", "nees.csv"))
-    figs.anees_plot(nees, os.path.join(fig_dir, "anees_corridor_%s.png" % model),
-                    "%s, corridor loop" % label)
+    figs.plot_nees(nees, os.path.join(fig_dir, "anees_corridor_%s.png" % model),
+                   ", %s, corridor loop" % label)
 
 
 # ---------------------------------------------------------------------------------------------

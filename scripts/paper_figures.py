@@ -11,50 +11,18 @@ import csv
 import math
 import os
 import random
+import sys
 
-import matplotlib
-
-matplotlib.use("Agg")  # no display
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
+                                "renders"))
+# The run pages' plotting module: its CSV reader, atomic PNG writer, colours (matplotlib on Agg).
+from report import COLORS, FILTERS, plot_nees, read_csv, save, wrap  # noqa: E402,F401
+import matplotlib  # noqa: E402
 import matplotlib.pyplot as plt  # noqa: E402
 import matplotlib.ticker  # noqa: E402
 
-COLORS = {"truth": "#0d0d0d", "classical": "#ff8000", "selective": "#0066ff"}
-FILTERS = ("classical", "selective")
-DPI = 100
 # The first filter drawn wider, so that it shows where the two curves coincide.
 WIDTHS = {"classical": 2.6, "selective": 1.2}
-
-
-def read_csv(path):
-    """Columns of a CSV file: floats where a field parses, text otherwise, NaN where empty."""
-    with open(path, newline="") as f:
-        rows = list(csv.reader(f))
-    if not rows:
-        raise ValueError("%s: empty file" % path)
-    header, data = rows[0], rows[1:]
-    columns = {name: [] for name in header}
-    for line, row in enumerate(data, start=2):
-        if len(row) != len(header):
-            raise ValueError("%s:%d: expected %d fields (got %d)" % (path, line, len(header),
-                                                                     len(row)))
-        for name, field in zip(header, row):
-            try:
-                columns[name].append(float(field) if field != "" else math.nan)
-            except ValueError:
-                columns[name].append(field)
-    return columns
-
-
-def save(fig, path):
-    """Saves a figure atomically (temporary name, then rename), without metadata."""
-    temp = path + ".tmp.png"
-    fig.savefig(temp, dpi=DPI, format="png", metadata={"Software": None})
-    plt.close(fig)
-    os.replace(temp, path)
-
-
-def wrap(angle):
-    return (angle + math.pi) % (2.0 * math.pi) - math.pi
 
 
 # ---------------------------------------------------------------------------------------------
@@ -276,28 +244,6 @@ def divergence_figure(studies, pairs, path, title):
         ax.grid(True, alpha=0.3, which="both")
     axes[0].legend(fontsize=7, loc="best")
     fig.suptitle(title)
-    fig.tight_layout()
-    save(fig, path)
-
-
-# ---------------------------------------------------------------------------------------------
-# Average NEES (not a figure of the paper).
-
-def anees_plot(nees, path, label):
-    fig, ax = plt.subplots(figsize=(8, 4.5))
-    t = nees["t"]
-    for f in FILTERS:
-        ax.plot(t, nees[f + "_anees"], color=COLORS[f], lw=1.1, label="%s ANEES" % f)
-    ax.plot(t, nees["lower"], color="0.3", lw=1.0, ls="--", label="95 % bounds")
-    ax.plot(t, nees["upper"], color="0.3", lw=1.0, ls="--")
-    runs = [n for n in nees["n_runs"] if not math.isnan(n)]
-    ax.set_yscale("log")
-    ax.set_xlabel("time (s)")
-    ax.set_ylabel("average pose NEES (3 dof)")
-    ax.set_title("Average NEES over %d runs, %s\n(a consistency test of this project, not a figure "
-                 "of the paper)" % (int(max(runs)) if runs else 0, label))
-    ax.grid(True, alpha=0.3, which="both")
-    ax.legend(loc="best", fontsize=8)
     fig.tight_layout()
     save(fig, path)
 
