@@ -24,11 +24,12 @@ published, docs/method.md):
 4. The figures, one PNG each under DIR/figures/ (names below), and DIR/claims.md (the table
    "claim | paper | default model | paper model", also printed) and DIR/claims.json.
 
-Then, once (issue 12 item 5, Figs. 4(c)-(d) at scale): one `mjslam run` per --scale-worlds world
-with configs/default.yaml, `slam.timing: realtime` and the world's tour once (control.driver:
-tour, driver.loop: false; not evaluated) -> DIR/scale/<world>, read up to the tour's last command (the robot then stands until the time
-limit); fig4cd_scale.png (period, processing, skipped scans and open loop against
-map size per filter) and the table "first step where the classical period reaches 0.7 s".
+Then, once (Figs. 4(c)-(d) at scale): one `mjslam run` per --scale-worlds world (WORLD or
+WORLD:SECONDS, its time limit) with configs/default.yaml, `slam.timing: realtime` and the world's
+tour once (control.driver: tour, driver.loop: false; not evaluated) -> DIR/scale/<world>, read up
+to the tour's last command (the robot then stands until the time limit); fig4cd_scale.png
+(period against map size per filter; map size, period, processing, skipped scans and open loop
+against time) and the table "first step where the classical period reaches 0.7 s".
 
 Figures (M = default or paper): fig3_pose_errors_M.png (corridor, seed run.seed),
 fig4c_processing_M.png and fig4d_open_loop_M.png (office, first run), fig5_points_M.png (office
@@ -375,10 +376,10 @@ def draw_model_figures(res, fig_dir, points_margin_m=0.5):
     studies = [(label_, res["studies"][key]) for key, label_, _ in STUDIES]
     figs.divergence_figure(studies, ("classical_selective", "selective_classical"),
                            os.path.join(fig_dir, "fig6_intermap_%s.png" % model),
-                           "Fig. 6 (paper): divergence between the two maps against #E, %s" % where)
+                           "Fig. 6 of the paper: divergence between the two maps against #E, %s" % where)
     figs.divergence_figure(studies, ("classical_truth", "selective_truth"),
                            os.path.join(fig_dir, "fig7_to_truth_%s.png" % model),
-                           "Fig. 7 (paper): divergence of each map to the truth against #E, %s"
+                           "Fig. 7 of the paper: divergence of each map to the truth against #E, %s"
                            % where)
     nees = figs.read_csv(os.path.join(res["dir"], "corridor", "nees.csv"))
     figs.plot_nees(nees, os.path.join(fig_dir, "anees_corridor_%s.png" % model),

@@ -103,7 +103,7 @@ def fig3_pose_errors(traj, path, label):
                 ax.set_title(f)
                 ax.legend(loc="upper left", fontsize=8)
         axes[-1][col].set_xlabel("time (s)")
-    fig.suptitle("Fig. 3 (paper): pose errors and ±2σ bounds, %s" % label)
+    fig.suptitle("Fig. 3 of the paper: pose errors and ±2σ bounds, %s" % label)
     fig.tight_layout()
     save(fig, path)
 
@@ -120,7 +120,7 @@ def fig4c_processing(traj, path, label, cost):
                 label=f)
     ax.set_xlabel("time (s)")
     ax.set_ylabel("accumulated processing time (s)")
-    ax.set_title("Fig. 4(c) (paper): accumulated processing time, %s\n"
+    ax.set_title("Fig. 4(c) of the paper: accumulated processing time, %s\n"
                  "modelled (control.processing: model, b = %g s, k = %g s)" % (label, cost[0], cost[1]))
     ax.grid(True, alpha=0.3)
     ax.legend(loc="upper left")
@@ -144,7 +144,7 @@ def fig4d_open_loop(traj, path, label, dt):
         ax.set_ylabel("accumulated open-loop time (s)")
         ax.grid(True, alpha=0.3)
         ax.legend(loc="upper left")
-    fig.suptitle("Fig. 4(d) (paper): accumulated open-loop time, %s" % label)
+    fig.suptitle("Fig. 4(d) of the paper: accumulated open-loop time, %s" % label)
     fig.tight_layout()
     save(fig, path)
 
@@ -196,7 +196,7 @@ def fig5_points(run_dir, path, label, num_points, margin_m, seed):
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
     ax.legend(loc="upper right", fontsize=8, framealpha=0.9)
-    ax.set_title("Fig. 5 (paper): #E = %d Monte Carlo points on the maps, %s" % (num_points, label))
+    ax.set_title("Fig. 5 of the paper: #E = %d Monte Carlo points on the maps, %s" % (num_points, label))
     fig.tight_layout()
     save(fig, path)
 
@@ -315,7 +315,7 @@ def fig4cd_scale(runs, path, cost, dt):
     axes[0][0].set_xlabel("the filter's map size (features)")
     axes[0][0].legend(fontsize=7, loc="upper left", markerscale=2)
     axes[0][1].legend(fontsize=7, loc="lower right")
-    fig.suptitle("Figs. 4(c)-(d) (paper) at scale: slam.timing realtime, periods and processing "
+    fig.suptitle("Figs. 4(c)-(d) of the paper at scale: slam.timing realtime, periods and processing "
                  "from the cost model (b = %g s, k = %g s per update per n²)" % (cost[0], cost[1]))
     fig.tight_layout()
     save(fig, path)
