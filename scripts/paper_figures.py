@@ -227,7 +227,7 @@ PAIR_COLORS = {"classical_selective": COLORS["classical"], "selective_classical"
 def divergence_figure(studies, pairs, path, title):
     """Mean and variance against #E of `pairs`, one line style per study. `studies`: list of
     (label, table of read_divergence)."""
-    fig, axes = plt.subplots(1, 2, figsize=(12, 4.8))
+    fig, axes = plt.subplots(1, 2, figsize=(12, 5.6))
     styles = ("-", "--", ":", "-.")
     for (label, table), ls in zip(studies, styles):
         for pair in pairs:
@@ -242,9 +242,10 @@ def divergence_figure(studies, pairs, path, title):
         ax.set_xlabel("#E (Monte Carlo points)")
         ax.set_ylabel(name)
         ax.grid(True, alpha=0.3, which="both")
-    axes[0].legend(fontsize=7, loc="best")
+    handles, labels = axes[0].get_legend_handles_labels()
+    fig.legend(handles, labels, fontsize=8, loc="lower center", ncol=2)  # below, hiding no curve
     fig.suptitle(title)
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, 0.14, 1, 1))
     save(fig, path)
 
 
