@@ -392,6 +392,7 @@ struct DivergenceCommand {
   std::vector<int> num_points = {100, 200, 500, 1000, 2000, 5000, 10000, 20000};
   int realisations = 100;
   std::string out;
+  eval::DivergenceParams params;
 };
 
 CLI::App* AddDivergence(CLI::App* cli, DivergenceCommand* c) {
@@ -404,12 +405,28 @@ CLI::App* AddDivergence(CLI::App* cli, DivergenceCommand* c) {
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
   divergence->add_option("--out", c->out, "Output CSV [RUN_DIR/divergence.csv]");
+  divergence->add_option("--floor-std", c->params.floor_std_m,
+                         "Std added to every Gaussian of a filter's map, m (0: its own covariance, the paper's)")
+      ->capture_default_str();
+  divergence->add_option("--truth-std", c->params.truth_std_m, "Std of the ground truth's Gaussians, m")
+      ->capture_default_str();
+  divergence->add_option("--weights", c->params.weights,
+                         "feature (each feature 1/L) or gaussian (each Gaussian the same)")
+      ->capture_default_str();
+  divergence->add_option("--line-spacing", c->params.line_spacing_m,
+                         "Largest spacing of a line's Gaussians, m")
+      ->capture_default_str();
+  divergence->add_option("--margin", c->params.margin_m, "Margin of the points' box, m")
+      ->capture_default_str();
   return divergence;
 }
 
 int DivergenceMain(const DivergenceCommand& c) {
   const std::string out = c.out.empty() ? rundir::PathIn(c.run_dir, rundir::kDivergenceFile) : c.out;
-  WriteDivergenceStudy(c.run_dir, c.num_points, c.realisations, out);
+  EvaluateOptions options;
+  options.divergence = c.params;
+  options.divergence.ValidateOrThrow();
+  WriteDivergenceStudy(c.run_dir, c.num_points, c.realisations, out, options);
   std::fprintf(stderr, "%s: written\n", out.c_str());
   return 0;
 }

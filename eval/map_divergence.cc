@@ -13,15 +13,39 @@ namespace mjslam::eval {
 std::vector<ParamProblem> DivergenceParams::Validate() const {
   ParamChecker check;
   check.Positive("line_spacing_m", line_spacing_m);
-  check.Positive("floor_std_m", floor_std_m);
+  check.NonNegative("floor_std_m", floor_std_m);
+  check.Positive("truth_std_m", truth_std_m);
+  check.OneOf("weights", weights, {"feature", "gaussian"});
   check.NonNegative("margin_m", margin_m);
   return check.problems();
 }
 
-GaussianMixture MapToMixture(const Map& map, const DivergenceParams& params) {
+namespace {
+
+// Adds `floor` to `covariance` and checks that the sum is positive definite.
+Eigen::Matrix2d FlooredCovariance(const Eigen::Matrix2d& covariance, const Eigen::Matrix2d& floor,
+                                  const MapFeature& feature) {
+  const Eigen::Matrix2d C = 0.5 * (covariance + covariance.transpose()) + floor;
+  if (!(C(0, 0) > 0.0 && C(0, 0) * C(1, 1) - C(0, 1) * C(1, 0) > 0.0)) {
+    throw std::invalid_argument("divergence: feature " + std::to_string(feature.id) +
+                                " has a covariance that is not positive definite with this "
+                                "floor (use a positive floor_std_m)");
+  }
+  return C;
+}
+
+// Every Gaussian the same weight ("gaussian" weights).
+void WeighEveryGaussianTheSame(GaussianMixture* mixture) {
+  const double w = 1.0 / static_cast<double>(mixture->weights.size());
+  for (double& weight : mixture->weights) weight = w;
+}
+
+}  // namespace
+
+GaussianMixture MapToMixture(const Map& map, const DivergenceParams& params, MapRole role) {
   params.ValidateOrThrow();
-  const Eigen::Matrix2d floor =
-      params.floor_std_m * params.floor_std_m * Eigen::Matrix2d::Identity();
+  const double floor_std = role == MapRole::kTruth ? params.truth_std_m : params.floor_std_m;
+  const Eigen::Matrix2d floor = floor_std * floor_std * Eigen::Matrix2d::Identity();
   // Features that become Gaussians, each with mass 1 / count.
   int count = 0;
   for (const MapFeature& f : map) {
@@ -31,7 +55,7 @@ GaussianMixture MapToMixture(const Map& map, const DivergenceParams& params) {
   for (const MapFeature& f : map) {
     if (f.type == MapFeature::Type::kCorner) {
       mixture.means.push_back(f.params);
-      mixture.covariances.push_back(f.covariance + floor);
+      mixture.covariances.push_back(FlooredCovariance(f.covariance, floor, f));
       mixture.weights.push_back(1.0 / count);
       continue;
     }
@@ -51,10 +75,11 @@ GaussianMixture MapToMixture(const Map& map, const DivergenceParams& params) {
       J.col(1) = r * t - s * n;
       const Eigen::Matrix2d C = J * f.covariance * J.transpose();
       mixture.means.push_back(r * n + s * t);
-      mixture.covariances.push_back(0.5 * (C + C.transpose()) + floor);
+      mixture.covariances.push_back(FlooredCovariance(C, floor, f));
       mixture.weights.push_back(1.0 / (static_cast<double>(count) * num));
     }
   }
+  if (params.weights == "gaussian" && !mixture.weights.empty()) WeighEveryGaussianTheSame(&mixture);
   return mixture;
 }
 
@@ -159,7 +184,7 @@ std::vector<DivergenceStatistics> DivergenceStudy(const Map& classical, const Ma
   }
   const GaussianMixture c = MapToMixture(classical, params);
   const GaussianMixture s = MapToMixture(selective, params);
-  const GaussianMixture t = MapToMixture(truth, params);
+  const GaussianMixture t = MapToMixture(truth, params, MapRole::kTruth);
   for (const auto* m : {&c, &s, &t}) {
     if (m->means.empty()) {
       throw std::invalid_argument("divergence: a map has no corner and no line with a segment");

@@ -16,10 +16,19 @@ struct DivergenceParams {
   /// Lines become Gaussians spaced at most this far apart along their
   /// segment (at least two per line), metres.
   double line_spacing_m = 0.05;
-  /// Standard deviation added in quadrature to every Gaussian, metres: the
-  /// ground truth's features (zero covariance) become near-degenerate
-  /// Gaussians of this size, and estimated ones never get thinner.
+  /// Standard deviation added in quadrature to every Gaussian of an
+  /// estimated map (a filter's), metres, >= 0: its features never get
+  /// thinner than this. 0 keeps each feature's own covariance, as the paper
+  /// does (then a feature with a singular covariance is an error).
   double floor_std_m = 0.02;
+  /// Standard deviation of the ground truth's Gaussians, metres, > 0: its
+  /// features are exact (zero covariance) and become near-degenerate
+  /// Gaussians of this size.
+  double truth_std_m = 0.02;
+  /// How the mass is split over a map: "feature" (each feature 1 / number of
+  /// features, a line's share split evenly over its Gaussians) or "gaussian"
+  /// (every Gaussian the same, so a line weighs by its seen length).
+  std::string weights = "feature";
   /// The bounding box of the Gaussians' means is grown by this on every side
   /// before the points are drawn in it, metres.
   double margin_m = 0.5;
@@ -37,13 +46,21 @@ struct GaussianMixture {
   std::vector<double> weights;
 };
 
+/// Which floor a map's Gaussians get: `floor_std_m` (an estimated map) or
+/// `truth_std_m` (the ground truth).
+enum class MapRole { kEstimate, kTruth };
+
 /// The mixture of a map. A corner is one Gaussian at its point with its
 /// covariance (+ floor). A line with a segment becomes Gaussians at evenly
 /// spaced positions s along it, p(s) = r n + s t (n = (cos al, sin al),
 /// t = (-sin al, cos al)), each with covariance J C J^T + floor, J = dp /
 /// d(r, al) = [n, r t - s n] at fixed s; lines without a segment are left
-/// out. Throws ParamError for invalid params.
-GaussianMixture MapToMixture(const Map& map, const DivergenceParams& params = {});
+/// out. The floor is `floor_std_m^2 I` for `MapRole::kEstimate`,
+/// `truth_std_m^2 I` for `MapRole::kTruth`. Throws ParamError for invalid
+/// params, std::invalid_argument for a Gaussian whose covariance is not
+/// positive definite (naming the feature's id).
+GaussianMixture MapToMixture(const Map& map, const DivergenceParams& params = {},
+                             MapRole role = MapRole::kEstimate);
 
 /// An axis-aligned box in W, metres.
 struct Box {

@@ -141,8 +141,9 @@ def plot_explored(traj, path):
     save(fig, path)
 
 
-def plot_nees(nees, path):
-    """Average NEES with its chi-square bounds over time (Fig. 6)."""
+def plot_nees(nees, path, where=""):
+    """Average NEES with its chi-square bounds over time (a consistency test; not a figure of the
+    paper)."""
     fig, ax = plt.subplots(figsize=(8, 4))
     t = nees["t"]
     for f in FILTERS:
@@ -158,7 +159,8 @@ def plot_nees(nees, path):
     ax.yaxis.set_major_formatter(plain)
     ax.yaxis.set_minor_formatter(plain)
     ax.tick_params(axis="y", which="minor", labelsize=7)
-    ax.set_title(f"Average NEES over {int(max(n_runs)) if n_runs else 0} runs")
+    ax.set_title(f"Average NEES over {int(max(n_runs)) if n_runs else 0} runs{where}\n"
+                 "(a consistency test, not a figure of the paper)")
     ax.grid(True, alpha=0.3, which="both")
     ax.legend(loc="best")
     fig.tight_layout()
@@ -166,7 +168,8 @@ def plot_nees(nees, path):
 
 
 def plot_divergence(div, path):
-    """Divergence mean and variance against #E (Fig. 7)."""
+    """Divergence mean and variance against #E of every pair (the paper's Figs. 6 and 7 together;
+    scripts/paper_experiments.py draws them apart)."""
     fig, axes = plt.subplots(1, 2, figsize=(10, 4))
     pairs = sorted(set(div["pair"]))
     for ax, key in zip(axes, ("mean", "variance")):
@@ -179,7 +182,8 @@ def plot_divergence(div, path):
         ax.set_ylabel(f"divergence {key} (nats)" if key == "mean" else "divergence variance (nats²)")
         ax.grid(True, alpha=0.3, which="both")
     axes[0].legend(fontsize=8)
-    fig.suptitle("Map divergence (KL) between the filters' maps and to the ground truth")
+    fig.suptitle("Map divergence (KL) between the filters' maps and to the ground truth "
+                 "(paper Figs. 6 and 7 together)")
     fig.tight_layout()
     save(fig, path)
 
@@ -308,11 +312,11 @@ def sweep_report(directory):
     body.append("<h2>Plots</h2>")
     if os.path.exists(nees_path):
         plot_nees(read_csv(nees_path), os.path.join(directory, "plot_nees.png"))
-        body.append('<h3>Average NEES and 95 % bounds (Fig. 6)</h3><img src="plot_nees.png" alt="average NEES">')
+        body.append('<h3>Average NEES and 95 % bounds (not a figure of the paper)</h3><img src="plot_nees.png" alt="average NEES">')
     div_path = os.path.join(directory, "divergence.csv")
     if os.path.exists(div_path):
         plot_divergence(read_csv(div_path), os.path.join(directory, "plot_divergence.png"))
-        body.append('<h3>Divergence against #E (Fig. 7)</h3><img src="plot_divergence.png" alt="divergence">')
+        body.append('<h3>Divergence against #E (paper Figs. 6 and 7 together)</h3><img src="plot_divergence.png" alt="divergence">')
     runs_dir = os.path.join(directory, "runs")
     if os.path.isdir(runs_dir):
         items = []

@@ -1,0 +1,58 @@
+#!/usr/bin/python3
+"""Smoke test of scripts/paper_experiments.py: tiny settings, then checks that the claims table
+has every claim with a verdict under both models and that every figure is a PNG.
+
+    /usr/bin/python3 tests/integration/paper_experiments_smoke_test.py SOURCE_DIR MJSLAM
+
+Exit status 0 when everything is there, 1 with the reasons otherwise.
+"""
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+
+FIGURES = ["fig3_pose_errors", "fig4c_processing", "fig4d_open_loop", "fig5_points",
+           "fig6_intermap", "fig7_to_truth", "anees_corridor"]
+VERDICTS = ("**yes**", "**partly**", "**no**")
+
+
+def main(source_dir, mjslam):
+    out = tempfile.mkdtemp(prefix="paper_smoke_")
+    try:
+        command = ["/usr/bin/python3", os.path.join(source_dir, "scripts", "paper_experiments.py"),
+                   "--out", out, "--mjslam", mjslam, "--runs", "2", "--jobs", "2",
+                   "--duration", "8", "--office-runs", "1", "--office-duration", "8",
+                   "--points", "100", "20000", "25000", "--realisations", "2",
+                   "--scale-duration", "8"]
+        result = subprocess.run(command, cwd=source_dir, capture_output=True, text=True)
+        problems = []
+        if result.returncode != 0:
+            problems.append("exit %d: %s" % (result.returncode, result.stderr[-2000:]))
+        claims = os.path.join(out, "claims.md")
+        text = open(claims).read() if os.path.exists(claims) else ""
+        rows = [line for line in text.splitlines() if line.startswith("| (")]
+        if len(rows) != 5:
+            problems.append("claims.md: %d claim rows, expected 5" % len(rows))
+        for row in rows:
+            if sum(row.count(v) for v in VERDICTS) != 2:
+                problems.append("claims.md: not one verdict per model in: %s" % row[:80])
+        names = ["%s_%s.png" % (f, m) for f in FIGURES for m in ("default", "paper")]
+        for name in names + ["fig4cd_scale.png"]:
+            path = os.path.join(out, "figures", name)
+            if not os.path.exists(path):
+                problems.append("missing figure %s" % name)
+                continue
+            with open(path, "rb") as f:
+                if f.read(8) != b"\x89PNG\r\n\x1a\n":
+                    problems.append("not a PNG: %s" % name)
+        for p in problems:
+            print(p)
+        print("%d problems" % len(problems))
+        return 1 if problems else 0
+    finally:
+        shutil.rmtree(out, ignore_errors=True)
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1], sys.argv[2]))
