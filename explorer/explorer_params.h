@@ -46,9 +46,12 @@ struct ExplorerParams {
   double wheel_radius_m = 0.0975;
 
   // --- Planning ---
-  /// Smallest distance between a planned path of h and an occupied cell,
-  /// metres.
-  double clearance_m = 0.50;
+  /// Smallest distance between a planned path of the axle's centre and an
+  /// occupied cell, metres: the hard limit. The default is the radius of the
+  /// disc about the axle that holds the body in every heading (0.328 m, to
+  /// the rear corners), so that the robot may turn anywhere on its path, and
+  /// 0.8 m doors stay passable (their middle has about 0.4 m).
+  double clearance_m = 0.35;
   /// Paths with less clearance than this pay extra cost, metres.
   double preferred_clearance_m = 0.9;
   /// Weight of that extra cost: a step at zero clearance costs (1 + weight)
@@ -104,6 +107,10 @@ struct ExplorerParams {
   // --- Tracking and limits ---
   /// Speed of h along straight parts of a path, m/s.
   double cruise_speed_mps = 0.4;
+  /// Speed of h where the path's clearance is `clearance_m` (a door), m/s;
+  /// the limit rises linearly to `cruise_speed_mps` at
+  /// `preferred_clearance_m`.
+  double narrow_speed_mps = 0.1;
   /// Command limits, m/s and rad/s (below the motor limits).
   double max_linear_speed_mps = 0.6;
   double max_angular_speed_radps = 1.2;
@@ -167,6 +174,7 @@ struct ExplorerParams {
     a->Visit(MJSLAM_NVP(blacklist_radius_m));
     a->Visit(MJSLAM_NVP(initial_turn_deg));
     a->Visit(MJSLAM_NVP(cruise_speed_mps));
+    a->Visit(MJSLAM_NVP(narrow_speed_mps));
     a->Visit(MJSLAM_NVP(max_linear_speed_mps));
     a->Visit(MJSLAM_NVP(max_angular_speed_radps));
     a->Visit(MJSLAM_NVP(max_linear_accel_mps2));
