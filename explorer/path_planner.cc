@@ -23,6 +23,27 @@ constexpr double kShortcutClearanceLossM = 0.02;
 
 Eigen::Vector2d LeftNormal(const Eigen::Vector2d& u) { return {-u.y(), u.x()}; }
 
+// A leg passes a narrow place (a door) when its clearance drops below
+// clearance_m plus this, metres (doors up to about 1 m).
+constexpr double kNarrowMarginM = 0.15;
+// A path whose first leg is narrow starts with a turn in place when it
+// leaves more than this off the heading, degrees.
+constexpr double kAlignBeforeNarrowDeg = 10.0;
+
+// Whether the segment [a, b] passes a narrow place (sampled every half cell).
+bool LegIsNarrow(const NavigationMap& map, const ExplorerParams& params,
+                 const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  const double length = (b - a).norm();
+  const int n =
+      std::max(1, static_cast<int>(std::ceil(length / (0.5 * map.grid().resolution()))));
+  for (int k = 0; k <= n; ++k) {
+    if (map.ClearanceAt(a + (double(k) / n) * (b - a)) < params.clearance_m + kNarrowMarginM) {
+      return true;
+    }
+  }
+  return false;
+}
+
 // Appends points every `step` along the segment [a, b) (b excluded).
 void AppendSegment(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double step, Path* path) {
   const double length = (b - a).norm();
@@ -220,6 +241,13 @@ Path SmoothPolyline(const std::vector<Eigen::Vector2d>& vertices, const Navigati
     double radius = std::min(params.max_turn_radius_m,
                              phi > kPi - 1e-6 ? 0.0 : std::min(available_in, available_out) /
                                                            tan_half);
+    // No arc next to a door: the robot stops and turns in place, so that it
+    // enters and leaves the door straight along the leg (with the axle's
+    // clearance, turning in place is safe anywhere on the path).
+    if (map != nullptr && (LegIsNarrow(*map, params, vertices[k - 1], v) ||
+                           LegIsNarrow(*map, params, v, vertices[k + 1]))) {
+      radius = 0.0;
+    }
     // Shrink the arc until it stays traversable.
     bool rounded = false;
     Path arc;
@@ -362,7 +390,10 @@ Path PlanPath(const NavigationMap& map, const ExplorerParams& params,
   // Turn toward the first leg first when it leaves far off the heading.
   if (path.size() >= 2) {
     const double error = WrapAngle(path.front().heading_rad - heading_rad);
-    if (std::abs(error) > DegToRad(params.turn_in_place_deg)) {
+    const double limit_deg = LegIsNarrow(map, params, vertices[0], vertices[1])
+                                 ? std::min(kAlignBeforeNarrowDeg, params.turn_in_place_deg)
+                                 : params.turn_in_place_deg;
+    if (std::abs(error) > DegToRad(limit_deg)) {
       path.front().turn_in_place = true;
       path.front().speed_mps = 0.0;
       path.front().curvature_per_m = 0.0;
