@@ -51,7 +51,7 @@ struct ExplorerParams {
   /// disc about the axle that holds the body in every heading (0.328 m, to
   /// the rear corners), so that the robot may turn anywhere on its path, and
   /// 0.8 m doors stay passable (their middle has about 0.4 m).
-  double clearance_m = 0.35;
+  double clearance_m = 0.30;
   /// Paths with less clearance than this pay extra cost, metres.
   double preferred_clearance_m = 0.9;
   /// Weight of that extra cost: a step at zero clearance costs (1 + weight)
