@@ -47,10 +47,11 @@ struct ExplorerParams {
 
   // --- Planning ---
   /// Smallest distance between a planned path of the axle's centre and an
-  /// occupied cell, metres: the hard limit. The default is the radius of the
-  /// disc about the axle that holds the body in every heading (0.328 m, to
-  /// the rear corners), so that the robot may turn anywhere on its path, and
-  /// 0.8 m doors stay passable (their middle has about 0.4 m).
+  /// occupied cell, metres: the hard limit. A disc of 0.328 m about the axle
+  /// holds the body in every heading (to the rear corners); 0.30 m keeps
+  /// 0.8 m doors passable (about 0.4 m in their middle, less once the pose
+  /// estimate smears the jambs) and leaves the rear corners in tight turns to
+  /// the safety layer.
   double clearance_m = 0.30;
   /// Paths with less clearance than this pay extra cost, metres.
   double preferred_clearance_m = 0.9;
