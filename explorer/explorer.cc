@@ -57,6 +57,7 @@ Explorer::Explorer(const ExplorerParams& params, double a_m)
     : params_(Validated(params, a_m)),
       a_m_(a_m),
       grid_(GridSettings(params)),
+      clearance_(ClearanceCapM(params)),
       tracker_(params, a_m) {
   if (params_.initial_turn_deg <= 0.0) phase_ = Phase::kExploring;
 }
@@ -124,6 +125,10 @@ std::vector<Eigen::Vector2d> Explorer::NearbyObstacles(const Pose2& X_WR) const 
   return points;
 }
 
+Eigen::Vector2d Explorer::AxleOf(const Pose2& X_WR) const {
+  return X_WR * Eigen::Vector2d(-a_m_, 0.0);
+}
+
 double Explorer::RemainingPath(const Pose2& X_WR) const {
   const Path& path = tracker_.path();
   if (path.empty()) return 0.0;
@@ -132,7 +137,9 @@ double Explorer::RemainingPath(const Pose2& X_WR) const {
 }
 
 bool Explorer::PlanToGoal(const NavigationMap& map, const Pose2& X_WR, double t_s) {
-  Path path = PlanPath(map, params_, goal_W_, X_WR.theta);
+  // The plan is the axle's (its clearance covers the body in every
+  // heading); the tracker follows the path of h that goes with it.
+  Path path = PathOfPointH(PlanPath(map, params_, goal_W_, X_WR.theta), a_m_, X_WR.theta);
   last_plan_t_s_ = t_s;
   if (path.empty()) return false;
   tracker_.SetPath(std::move(path));
@@ -192,7 +199,8 @@ double Explorer::BestViewpoint(const NavigationMap& map, const Eigen::Vector2d& 
 }
 
 void Explorer::ChooseGoal(const Pose2& X_WR, double t_s) {
-  const NavigationMap map(grid_, params_, X_WR.translation());
+  clearance_.Update(grid_);
+  const NavigationMap map(grid_, clearance_, params_, AxleOf(X_WR));
   // The scan's frontier points first, the grid's when none of those will do.
   // `unreachable` records a frontier with gain that failed or has no
   // reachable cell (a frontier only near reached goals does not count: the
@@ -290,7 +298,8 @@ bool Explorer::ScanBlocksPath() const {
 }
 
 void Explorer::Replan(const Pose2& X_WR, double t_s) {
-  const NavigationMap map(grid_, params_, X_WR.translation());
+  clearance_.Update(grid_);
+  const NavigationMap map(grid_, clearance_, params_, AxleOf(X_WR));
   const double remaining_before = best_remaining_m_;
   if (PlanToGoal(map, X_WR, t_s)) {
     // Keep the progress clock: a new plan is not progress.

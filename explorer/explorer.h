@@ -10,6 +10,7 @@
 #include "common/laser_scan.h"
 #include "common/pose2.h"
 #include "common/records.h"
+#include "explorer/clearance_field.h"
 #include "explorer/explorer_params.h"
 #include "explorer/occupancy_grid.h"
 #include "explorer/path_planner.h"
@@ -131,7 +132,8 @@ class Explorer {
   Twist2 Recover(const Twist2& command, const Pose2& X_WR,
                  const std::vector<Eigen::Vector2d>& obstacles, double dt_s);
 
-  // Picks a goal and plans a path to it; finishes when there is none.
+  // Picks a goal (a cell for the axle) and plans a path to it; finishes when
+  // there is none.
   void ChooseGoal(const Pose2& X_WR, double t_s);
   // The frontier points among `points` with gain that are not blacklisted
   // (appended to frontier_points_), scored, best first; sets `unreachable`
@@ -154,12 +156,16 @@ class Explorer {
   bool Blacklisted(const Eigen::Vector2d& p_W, bool* failed = nullptr) const;
   // Obstacle points near h: the last scan's echoes and occupied cells.
   std::vector<Eigen::Vector2d> NearbyObstacles(const Pose2& X_WR) const;
+  // The centre of the axle, a_m behind h: the point the planner plans for.
+  Eigen::Vector2d AxleOf(const Pose2& X_WR) const;
   // Remaining length of the path from h, metres.
   double RemainingPath(const Pose2& X_WR) const;
 
   ExplorerParams params_;
   double a_m_;
   OccupancyGrid grid_;
+  // The grid's clearance, brought up to date before each NavigationMap.
+  ClearanceField clearance_;
   PathTracker tracker_;
   Phase phase_ = Phase::kInitialTurn;
 

@@ -47,6 +47,9 @@ std::vector<ParamProblem> ExplorerParams::Validate() const {
   check.NonNegative("blacklist_radius_m", blacklist_radius_m);
   check.InRange("initial_turn_deg", initial_turn_deg, 0.0, 720.0);
   check.Positive("cruise_speed_mps", cruise_speed_mps);
+  check.Positive("narrow_speed_mps", narrow_speed_mps);
+  check.Require(narrow_speed_mps <= cruise_speed_mps, "narrow_speed_mps", narrow_speed_mps,
+                "at most cruise_speed_mps");
   check.Positive("max_linear_speed_mps", max_linear_speed_mps);
   check.Require(cruise_speed_mps <= max_linear_speed_mps, "cruise_speed_mps",
                 cruise_speed_mps, "at most max_linear_speed_mps");

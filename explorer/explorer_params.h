@@ -46,9 +46,13 @@ struct ExplorerParams {
   double wheel_radius_m = 0.0975;
 
   // --- Planning ---
-  /// Smallest distance between a planned path of h and an occupied cell,
-  /// metres.
-  double clearance_m = 0.50;
+  /// Smallest distance between a planned path of the axle's centre and an
+  /// occupied cell, metres: the hard limit. A disc of 0.328 m about the axle
+  /// holds the body in every heading (to the rear corners); 0.30 m keeps
+  /// 0.8 m doors passable (about 0.4 m in their middle, less once the pose
+  /// estimate smears the jambs) and leaves the rear corners in tight turns to
+  /// the safety layer.
+  double clearance_m = 0.30;
   /// Paths with less clearance than this pay extra cost, metres.
   double preferred_clearance_m = 0.9;
   /// Weight of that extra cost: a step at zero clearance costs (1 + weight)
@@ -104,6 +108,10 @@ struct ExplorerParams {
   // --- Tracking and limits ---
   /// Speed of h along straight parts of a path, m/s.
   double cruise_speed_mps = 0.4;
+  /// Speed of h where the path's clearance is `clearance_m` (a door), m/s;
+  /// the limit rises linearly to `cruise_speed_mps` at
+  /// `preferred_clearance_m`.
+  double narrow_speed_mps = 0.1;
   /// Command limits, m/s and rad/s (below the motor limits).
   double max_linear_speed_mps = 0.6;
   double max_angular_speed_radps = 1.2;
@@ -167,6 +175,7 @@ struct ExplorerParams {
     a->Visit(MJSLAM_NVP(blacklist_radius_m));
     a->Visit(MJSLAM_NVP(initial_turn_deg));
     a->Visit(MJSLAM_NVP(cruise_speed_mps));
+    a->Visit(MJSLAM_NVP(narrow_speed_mps));
     a->Visit(MJSLAM_NVP(max_linear_speed_mps));
     a->Visit(MJSLAM_NVP(max_angular_speed_radps));
     a->Visit(MJSLAM_NVP(max_linear_accel_mps2));

@@ -73,6 +73,12 @@ void OccupancyGrid::EnsureCovers(const Eigen::Vector2d& lo, const Eigen::Vector2
   }
   log_odds_.swap(grown);
   limits_ = grown_limits;
+  if (width > 0) {
+    lattice_origin_ -= Eigen::Vector2i(dx, dy);
+  } else {
+    lattice_origin_ = Eigen::Vector2i(static_cast<int>(std::lround(new_lo.x() / r)),
+                                      static_cast<int>(std::lround(new_lo.y() / r)));
+  }
   marks_.assign(log_odds_.size(), 0);
   touched_.clear();
 }
@@ -94,9 +100,14 @@ void OccupancyGrid::MarkRayFree(const Eigen::Vector2d& from, const Eigen::Vector
 void OccupancyGrid::ApplyMarks() {
   for (const int i : touched_) {
     const double delta = marks_[i] == 2 ? settings_.log_odds_hit : settings_.log_odds_miss;
+    const bool was_occupied = log_odds_[i] >= settings_.occupied_threshold;
     log_odds_[i] = static_cast<float>(std::clamp(log_odds_[i] + delta, settings_.log_odds_min,
                                                  settings_.log_odds_max));
     marks_[i] = 0;
+    // The log of occupancy changes (read by ClearanceField).
+    if ((log_odds_[i] >= settings_.occupied_threshold) != was_occupied) {
+      occupancy_changes_.push_back(limits_.CellOfIndex(i) + lattice_origin_);
+    }
   }
   touched_.clear();
 }

@@ -90,6 +90,16 @@ class OccupancyGrid {
   /// Area of the known-free cells, m^2 (for reports and tests).
   double KnownFreeArea() const;
 
+  /// Lattice index of cell (0, 0): cell (ix, iy) is lattice cell
+  /// (ix, iy) + lattice_origin(). Lattice indices do not change when the grid
+  /// grows (the origin moves by whole cells).
+  const Eigen::Vector2i& lattice_origin() const { return lattice_origin_; }
+  /// Every change of a cell into or out of the occupied state since the
+  /// grid was made, as lattice indices in the order they happened (a cell
+  /// may appear more than once). Append-only: a reader remembers how many
+  /// entries it has read (ClearanceField does).
+  const std::vector<Eigen::Vector2i>& occupancy_changes() const { return occupancy_changes_; }
+
  private:
   // Per beam of a scan: the range up to which it proves free space, and
   // whether it ends on an echo that is inserted as occupied.
@@ -126,6 +136,8 @@ class OccupancyGrid {
   // marked cells.
   std::vector<std::uint8_t> marks_;
   std::vector<int> touched_;
+  Eigen::Vector2i lattice_origin_ = Eigen::Vector2i::Zero();
+  std::vector<Eigen::Vector2i> occupancy_changes_;
 };
 
 }  // namespace mjslam::explorer

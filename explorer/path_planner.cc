@@ -15,47 +15,34 @@ namespace mjslam::explorer {
 namespace {
 
 constexpr double kInfinity = std::numeric_limits<double>::infinity();
-// Squared distance standing for "no occupied cell", cells^2.
-constexpr double kFar = 1e12;
-
-// One-dimensional squared Euclidean distance transform of `f` (n samples)
-// into `d` (Felzenszwalb and Huttenlocher 2012, Algorithm 1).
-void DistanceTransform1d(const std::vector<double>& f, int n, std::vector<double>* d) {
-  std::vector<int> v(n);
-  std::vector<double> z(n + 1);
-  int k = 0;
-  v[0] = 0;
-  z[0] = -kInfinity;
-  z[1] = kInfinity;
-  for (int q = 1; q < n; ++q) {
-    double s = 0.0;
-    while (true) {
-      s = ((f[q] + double(q) * q) - (f[v[k]] + double(v[k]) * v[k])) / (2.0 * q - 2.0 * v[k]);
-      if (s <= z[k] && k > 0) {
-        --k;
-      } else {
-        break;
-      }
-    }
-    if (s <= z[k]) {  // k == 0: replace the only parabola
-      v[0] = q;
-      z[0] = -kInfinity;
-      z[1] = kInfinity;
-      continue;
-    }
-    ++k;
-    v[k] = q;
-    z[k] = s;
-    z[k + 1] = kInfinity;
-  }
-  k = 0;
-  for (int q = 0; q < n; ++q) {
-    while (z[k + 1] < q) ++k;
-    (*d)[q] = (double(q) - v[k]) * (double(q) - v[k]) + f[v[k]];
-  }
-}
+// How much less clearance a shortcut may keep than the cell path it
+// replaces, metres: little, so that a leg through a door crosses it near its
+// middle and nearly square to it (at most acos(0.38 / 0.4), 18 deg, off the
+// normal of a 0.8 m door).
+constexpr double kShortcutClearanceLossM = 0.02;
 
 Eigen::Vector2d LeftNormal(const Eigen::Vector2d& u) { return {-u.y(), u.x()}; }
+
+// A leg passes a narrow place (a door) when its clearance drops below
+// clearance_m plus this, metres (doors up to about 1 m).
+constexpr double kNarrowMarginM = 0.15;
+// A path whose first leg is narrow starts with a turn in place when it
+// leaves more than this off the heading, degrees.
+constexpr double kAlignBeforeNarrowDeg = 10.0;
+
+// Whether the segment [a, b] passes a narrow place (sampled every half cell).
+bool LegIsNarrow(const NavigationMap& map, const ExplorerParams& params,
+                 const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  const double length = (b - a).norm();
+  const int n =
+      std::max(1, static_cast<int>(std::ceil(length / (0.5 * map.grid().resolution()))));
+  for (int k = 0; k <= n; ++k) {
+    if (map.ClearanceAt(a + (double(k) / n) * (b - a)) < params.clearance_m + kNarrowMarginM) {
+      return true;
+    }
+  }
+  return false;
+}
 
 // Appends points every `step` along the segment [a, b) (b excluded).
 void AppendSegment(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double step, Path* path) {
@@ -73,46 +60,49 @@ void AppendSegment(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double st
 
 }  // namespace
 
+double ClearanceCapM(const ExplorerParams& params) {
+  return std::max(params.preferred_clearance_m, params.clearance_m);
+}
+
 NavigationMap::NavigationMap(const OccupancyGrid& grid, const ExplorerParams& params,
                              const Eigen::Vector2d& p_W_start)
-    : grid_(grid), params_(params), p_W_start_(p_W_start), start_(grid.CellOf(p_W_start)) {
+    : grid_(grid),
+      params_(params),
+      p_W_start_(p_W_start),
+      start_(grid.CellOf(p_W_start)),
+      own_clearance_(ClearanceCapM(params)),
+      clearance_(&own_clearance_.values()) {
+  own_clearance_.Recompute(grid_);
+  PlanCosts();
+}
+
+NavigationMap::NavigationMap(const OccupancyGrid& grid, const ClearanceField& clearance,
+                             const ExplorerParams& params, const Eigen::Vector2d& p_W_start)
+    : grid_(grid),
+      params_(params),
+      p_W_start_(p_W_start),
+      start_(grid.CellOf(p_W_start)),
+      own_clearance_(ClearanceCapM(params)),
+      clearance_(&clearance.values()) {
+  MJSLAM_CHECK(clearance.cap_m() == ClearanceCapM(params));
+  MJSLAM_CHECK(clearance.limits().width() == grid.width() &&
+               clearance.limits().height() == grid.height() &&
+               clearance.limits().origin() == grid.origin());
+  PlanCosts();
+}
+
+void NavigationMap::PlanCosts() {
   const int w = grid_.width();
   const int h = grid_.height();
-  const int n = w * h;
-  clearance_ = Grid2<float>(grid_.limits(), 0.0f);
   cost_ = Grid2<double>(grid_.limits(), kInfinity);
   parent_ = Grid2<int>(grid_.limits(), -1);
-  if (n == 0) return;
-
-  // Clearance: exact Euclidean distance transform of the occupied cells,
-  // columns then rows.
-  std::vector<double> squared(n);
-  for (int i = 0; i < n; ++i) {
-    squared[i] = grid_.State(i % w, i / w) == CellState::kOccupied ? 0.0 : kFar;
-  }
-  {
-    std::vector<double> f(h), d(h);
-    for (int ix = 0; ix < w; ++ix) {
-      for (int iy = 0; iy < h; ++iy) f[iy] = squared[iy * w + ix];
-      DistanceTransform1d(f, h, &d);
-      for (int iy = 0; iy < h; ++iy) squared[iy * w + ix] = d[iy];
-    }
-  }
-  {
-    std::vector<double> f(w), d(w);
-    for (int iy = 0; iy < h; ++iy) {
-      for (int ix = 0; ix < w; ++ix) f[ix] = squared[iy * w + ix];
-      DistanceTransform1d(f, w, &d);
-      for (int ix = 0; ix < w; ++ix) squared[iy * w + ix] = d[ix];
-    }
-  }
-  for (int i = 0; i < n; ++i) {
-    clearance_[i] = static_cast<float>(std::sqrt(std::min(squared[i], kFar)) * grid_.resolution());
-  }
+  if (w * h == 0) return;
+  const Grid2<float>& clearance = *clearance_;
 
   // Dijkstra from the start cell, ties broken by cell index (deterministic).
   if (!grid_.Contains(start_.x(), start_.y())) return;
   escape_ = !Comfortable(start_.x(), start_.y());
+  start_clearance_ = clearance[grid_.Index(start_.x(), start_.y())];
   traversable_ = Grid2<std::uint8_t>(grid_.limits(), 0);
   for (int iy = 0; iy < h; ++iy) {
     for (int ix = 0; ix < w; ++ix) traversable_(ix, iy) = TraversableSlow(ix, iy);
@@ -143,7 +133,7 @@ NavigationMap::NavigationMap(const OccupancyGrid& grid, const ExplorerParams& pa
       if (k >= 4 && (!traversable(ix + dx[k], iy) || !traversable(ix, iy + dy[k]))) continue;
       const int j = grid_.Index(jx, jy);
       const double shortfall =
-          std::max(0.0, params_.preferred_clearance_m - clearance_[j]) /
+          std::max(0.0, params_.preferred_clearance_m - clearance[j]) /
           params_.preferred_clearance_m;
       const double step = (k < 4 ? r : r * std::sqrt(2.0)) *
                           (1.0 + params_.clearance_cost_weight * shortfall);
@@ -160,7 +150,7 @@ NavigationMap::NavigationMap(const OccupancyGrid& grid, const ExplorerParams& pa
 }
 
 double NavigationMap::Clearance(int ix, int iy) const {
-  return grid_.Contains(ix, iy) ? clearance_[grid_.Index(ix, iy)] : 0.0;
+  return grid_.Contains(ix, iy) ? (*clearance_)[grid_.Index(ix, iy)] : 0.0;
 }
 
 double NavigationMap::ClearanceAt(const Eigen::Vector2d& p_W) const {
@@ -178,15 +168,18 @@ bool NavigationMap::TraversableSlow(int ix, int iy) const {
   if (!grid_.Contains(ix, iy)) return false;
   const CellState state = grid_.State(ix, iy);
   if (state == CellState::kOccupied) return false;
+  // Near a start that lacks clearance: cells no closer to an obstacle than
+  // the start (so that a robot stopped in a doorway off its middle gets out
+  // without scraping past the jamb).
   if (escape_ && (grid_.CellCenter(ix, iy) - p_W_start_).norm() <= params_.escape_radius_m) {
-    return true;
+    return (*clearance_)[grid_.Index(ix, iy)] >= start_clearance_;
   }
-  return state == CellState::kFree && clearance_[grid_.Index(ix, iy)] >= params_.clearance_m;
+  return state == CellState::kFree && (*clearance_)[grid_.Index(ix, iy)] >= params_.clearance_m;
 }
 
 bool NavigationMap::Comfortable(int ix, int iy) const {
   return grid_.Contains(ix, iy) && grid_.State(ix, iy) == CellState::kFree &&
-         clearance_[grid_.Index(ix, iy)] >= params_.clearance_m;
+         (*clearance_)[grid_.Index(ix, iy)] >= params_.clearance_m;
 }
 
 bool NavigationMap::TraversableAt(const Eigen::Vector2d& p_W) const {
@@ -248,6 +241,13 @@ Path SmoothPolyline(const std::vector<Eigen::Vector2d>& vertices, const Navigati
     double radius = std::min(params.max_turn_radius_m,
                              phi > kPi - 1e-6 ? 0.0 : std::min(available_in, available_out) /
                                                            tan_half);
+    // No arc next to a door: the robot stops and turns in place, so that it
+    // enters and leaves the door straight along the leg (with the axle's
+    // clearance, turning in place is safe anywhere on the path).
+    if (map != nullptr && (LegIsNarrow(*map, params, vertices[k - 1], v) ||
+                           LegIsNarrow(*map, params, v, vertices[k + 1]))) {
+      radius = 0.0;
+    }
     // Shrink the arc until it stays traversable.
     bool rounded = false;
     Path arc;
@@ -314,6 +314,16 @@ Path SmoothPolyline(const std::vector<Eigen::Vector2d>& vertices, const Navigati
       v = std::min({v, params.max_angular_speed_radps / kappa,
                     std::sqrt(params.max_lateral_accel_mps2 / kappa)});
     }
+    // Slower where the clearance is small (doors), from the narrow speed
+    // at clearance_m to the cruise speed at the preferred clearance.
+    if (map != nullptr && params.preferred_clearance_m > params.clearance_m) {
+      const double fraction =
+          std::clamp((map->ClearanceAt(point.p_W) - params.clearance_m) /
+                         (params.preferred_clearance_m - params.clearance_m),
+                     0.0, 1.0);
+      v = std::min(v, params.narrow_speed_mps +
+                          fraction * (params.cruise_speed_mps - params.narrow_speed_mps));
+    }
     if (point.turn_in_place || i + 1 == size) v = 0.0;
     point.speed_mps = v;
   }
@@ -348,11 +358,12 @@ Path PlanPath(const NavigationMap& map, const ExplorerParams& params,
     if (!map.SegmentTraversable(points[from], points[to])) return false;
     double needed = params.preferred_clearance_m;
     for (size_t k = from; k <= to; ++k) needed = std::min(needed, clearance[k]);
-    needed -= grid.resolution();
-    const double length = (points[to] - points[from]).norm();
+    needed -= kShortcutClearanceLossM;
+    const Eigen::Vector2d leg = points[to] - points[from];
+    const double length = leg.norm();
     const int n = std::max(1, static_cast<int>(std::ceil(length / (0.5 * grid.resolution()))));
     for (int k = 0; k <= n; ++k) {
-      const Eigen::Vector2d p = points[from] + (double(k) / n) * (points[to] - points[from]);
+      const Eigen::Vector2d p = points[from] + (double(k) / n) * leg;
       if (map.ClearanceAt(p) < needed) return false;
     }
     return true;
@@ -379,11 +390,29 @@ Path PlanPath(const NavigationMap& map, const ExplorerParams& params,
   // Turn toward the first leg first when it leaves far off the heading.
   if (path.size() >= 2) {
     const double error = WrapAngle(path.front().heading_rad - heading_rad);
-    if (std::abs(error) > DegToRad(params.turn_in_place_deg)) {
+    const double limit_deg = LegIsNarrow(map, params, vertices[0], vertices[1])
+                                 ? std::min(kAlignBeforeNarrowDeg, params.turn_in_place_deg)
+                                 : params.turn_in_place_deg;
+    if (std::abs(error) > DegToRad(limit_deg)) {
       path.front().turn_in_place = true;
       path.front().speed_mps = 0.0;
       path.front().curvature_per_m = 0.0;
     }
+  }
+  return path;
+}
+
+Path PathOfPointH(const Path& axle_path, double a_m, double heading_rad) {
+  Path path = axle_path;
+  for (size_t i = 0; i < path.size(); ++i) {
+    // At a stop-and-turn point h still has the heading it arrived with (the
+    // robot's own at the start); it reaches the next point by the turn.
+    const double arriving = i == 0 ? heading_rad : axle_path[i - 1].heading_rad;
+    const double th = axle_path[i].turn_in_place ? arriving : axle_path[i].heading_rad;
+    path[i].p_W = axle_path[i].p_W + a_m * Eigen::Vector2d(std::cos(th), std::sin(th));
+  }
+  for (size_t i = 1; i < path.size(); ++i) {
+    path[i].s_m = path[i - 1].s_m + (path[i].p_W - path[i - 1].p_W).norm();
   }
   return path;
 }

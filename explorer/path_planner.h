@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 
 #include "common/grid2.h"
+#include "explorer/clearance_field.h"
 #include "explorer/explorer_params.h"
 #include "explorer/occupancy_grid.h"
 
@@ -31,25 +32,36 @@ struct PathPoint {
 /// A path is its points in order; empty when there is none.
 using Path = std::vector<PathPoint>;
 
-/// The grid seen by the planner: the clearance of every cell (Euclidean
-/// distance to the nearest occupied cell, by the exact distance transform of
-/// Felzenszwalb and Huttenlocher, "Distance Transforms of Sampled Functions",
-/// 2012) and the cost to reach every cell from a start point (Dijkstra,
-/// 8-connected, on known-free cells with at least `clearance_m`; each step
-/// costs its length times 1 + `clearance_cost_weight` * the shortfall of
-/// clearance below `preferred_clearance_m`, relative). When the start cell
-/// itself lacks that clearance, cells within `escape_radius_m` of the start
-/// need only be not occupied, so that a robot stopped close to a wall can
-/// plan its way out.
+/// The cap of the clearance the planner needs, metres: the larger of
+/// `preferred_clearance_m` and `clearance_m` (no rule reads more).
+double ClearanceCapM(const ExplorerParams& params);
+
+/// The grid seen by the planner: the clearance of every cell (a
+/// ClearanceField capped at ClearanceCapM) and the cost to reach every cell
+/// from a start point (Dijkstra, 8-connected, on known-free cells with at
+/// least `clearance_m`; each step costs its length times 1 +
+/// `clearance_cost_weight` * the shortfall of clearance below
+/// `preferred_clearance_m`, relative). When the start cell itself lacks that
+/// clearance, cells within `escape_radius_m` of the start need only be not
+/// occupied and no closer to an occupied cell than the start, so that a
+/// robot stopped close to a wall can plan its way out.
 class NavigationMap {
  public:
-  /// Builds the map of `grid` (which must outlive it) from `p_W_start`.
+  /// Builds the map of `grid` (which must outlive it) from `p_W_start`,
+  /// computing the clearance over the whole grid.
   NavigationMap(const OccupancyGrid& grid, const ExplorerParams& params,
                 const Eigen::Vector2d& p_W_start);
+  /// The same with a clearance field kept up to date by the caller: it must
+  /// be current for `grid` (its limits equal the grid's) with a cap of
+  /// ClearanceCapM(params), and outlive the map.
+  NavigationMap(const OccupancyGrid& grid, const ClearanceField& clearance,
+                const ExplorerParams& params, const Eigen::Vector2d& p_W_start);
+  NavigationMap(const NavigationMap&) = delete;
+  NavigationMap& operator=(const NavigationMap&) = delete;
 
   const OccupancyGrid& grid() const { return grid_; }
-  /// Clearance of a cell, metres (large when there is no occupied cell;
-  /// 0 outside the grid).
+  /// Clearance of a cell, metres (at most ClearanceCapM; 0 outside the
+  /// grid).
   double Clearance(int ix, int iy) const;
   /// Clearance at a world point (its cell), metres.
   double ClearanceAt(const Eigen::Vector2d& p_W) const;
@@ -72,6 +84,8 @@ class NavigationMap {
  private:
   // Traversable() from the grid and the clearance.
   bool TraversableSlow(int ix, int iy) const;
+  // The traversable cells and the Dijkstra costs from the start.
+  void PlanCosts();
 
   const OccupancyGrid& grid_;
   ExplorerParams params_;
@@ -79,10 +93,15 @@ class NavigationMap {
   Eigen::Vector2i start_;
   // Whether the escape rule applies (the start lacks clearance).
   bool escape_ = false;
-  // Per cell of the grid: clearance, metres; Traversable(), computed once
-  // (no cells when the start is outside the grid); path cost, metres; the
-  // linear index of the cell before it on its cheapest path (-1: none).
-  Grid2<float> clearance_;
+  // The start cell's clearance, metres.
+  float start_clearance_ = 0.0f;
+  // The clearance computed by the first constructor (unused by the second).
+  ClearanceField own_clearance_;
+  // Per cell of the grid: clearance, metres (the field's values);
+  // Traversable(), computed once (no cells when the start is outside the
+  // grid); path cost, metres; the linear index of the cell before it on its
+  // cheapest path (-1: none).
+  const Grid2<float>* clearance_;
   Grid2<std::uint8_t> traversable_;
   Grid2<double> cost_;
   Grid2<int> parent_;
@@ -106,6 +125,13 @@ Path PlanPath(const NavigationMap& map, const ExplorerParams& params,
 /// `vertices` in W, at least two; `map` may be null (no collision check).
 Path SmoothPolyline(const std::vector<Eigen::Vector2d>& vertices, const NavigationMap* map,
                     const ExplorerParams& params);
+
+/// The path of h (`a_m` ahead of the axle, along the heading) when the axle
+/// follows `axle_path` (a PlanPath of the axle): each point moved by a_m along
+/// its heading; at a stop-and-turn point h keeps the heading it arrives
+/// with (`heading_rad`, the robot's, for the first point) and the turn in
+/// place carries it to the next point. Arc lengths are those of h.
+Path PathOfPointH(const Path& axle_path, double a_m, double heading_rad);
 
 /// Whether every point of `path` from index `from` on keeps `clearance_m`
 /// from every point of `obstacles_W` (scan echoes), metres.

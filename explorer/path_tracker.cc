@@ -15,6 +15,8 @@ namespace {
 constexpr double kMinDriveSpeedMps = 0.08;
 // A stop-and-turn point is reached when h is this close, metres.
 constexpr double kTurnPointToleranceM = 0.1;
+// ... or when h is this close and the point is not ahead, metres.
+constexpr double kTurnPointNearM = 0.3;
 // An in-place turn is finished within this heading error, radians.
 constexpr double kTurnDoneRad = 0.1;
 // How far ahead of the last nearest point h's nearest point is searched, m.
@@ -64,9 +66,17 @@ Twist2 PathTracker::Command(const Pose2& X_WR, double dt_s) {
     // The next stop-and-turn point at or after the nearest one.
     int stop = index_;
     while (stop < n - 1 && !path_[stop].turn_in_place) ++stop;
-    if (!done_ && path_[stop].turn_in_place && turning_at_ != stop &&
-        (path_[stop].p_W - h).norm() < kTurnPointToleranceM) {
-      turning_at_ = stop;
+    // It is reached when h is close, or near and no longer ahead (h passed
+    // beside it: steering at it would only turn the robot in place, about
+    // the axle, around it).
+    if (!done_ && path_[stop].turn_in_place && turning_at_ != stop) {
+      const Eigen::Vector2d to_stop = path_[stop].p_W - h;
+      const double bearing = WrapAngle(std::atan2(to_stop.y(), to_stop.x()) - X_WR.theta);
+      if (to_stop.norm() < kTurnPointToleranceM ||
+          (to_stop.norm() < kTurnPointNearM &&
+           std::abs(bearing) > DegToRad(params_.turn_in_place_deg))) {
+        turning_at_ = stop;
+      }
     }
     if (done_) {
       // Brake.

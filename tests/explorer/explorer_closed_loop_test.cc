@@ -41,13 +41,18 @@ struct EpisodeResult {
   std::string reason;
   double distance_m = 0.0;
   std::vector<double> commands;
+  // Positions of h at every step.
+  std::vector<Eigen::Vector2d> positions_W;
 };
 
-EpisodeResult RunEpisode(const Pose2& X_WR0, double duration_s, double door_width_m = 1.2) {
+// Runs the explorer from `X_WR0` among `walls` for at most `duration_s`;
+// the seen fraction is of the area reachable in `seen_walls`.
+EpisodeResult RunEpisodeIn(const std::vector<Wall>& walls, const std::vector<Wall>& seen_walls,
+                           const Pose2& X_WR0, double duration_s) {
   KinematicSim::Config config;
-  KinematicSim sim(TwoRooms(door_width_m), X_WR0, config);
+  KinematicSim sim(walls, X_WR0, config);
   Explorer explorer(ExplorerParams{}, config.a_m);
-  testing::SeenArea seen(TwoRooms(), X_WR0.translation());
+  testing::SeenArea seen(seen_walls, X_WR0.translation());
   EpisodeResult result;
   const double dt = 0.1;
   for (double t = 0.0; t < duration_s; t += dt) {
@@ -56,6 +61,7 @@ EpisodeResult RunEpisode(const Pose2& X_WR0, double duration_s, double door_widt
     const ExplorerOutput out = explorer.Step(sim.X_WR(), &scan, config.X_RS, t, dt);
     result.commands.push_back(out.command.v_mps);
     result.commands.push_back(out.command.w_radps);
+    result.positions_W.push_back(sim.X_WR().translation());
     if (out.finished) {
       result.finished = true;
       result.reason = out.finish_reason;
@@ -69,6 +75,10 @@ EpisodeResult RunEpisode(const Pose2& X_WR0, double duration_s, double door_widt
   result.contacts = sim.contacts();
   result.distance_m = sim.distance_m();
   return result;
+}
+
+EpisodeResult RunEpisode(const Pose2& X_WR0, double duration_s, double door_width_m = 1.2) {
+  return RunEpisodeIn(TwoRooms(door_width_m), TwoRooms(), X_WR0, duration_s);
 }
 
 // From two start poses (one in the first room facing a wall 1 m ahead, one
@@ -89,10 +99,6 @@ TEST(ExplorerClosedLoopTest, ExploresTwoRoomsWithoutContact) {
   }
 }
 
-// A door too narrow for the robot (0.7 m: the body is 0.38 m wide but the
-// paths keep 0.5 m clearance): the explorer explores its own room, does not
-// circle in front of the door, and ends with `unreachable` well before the
-// time limit.
 TEST(ExplorerClosedLoopTest, GetsFreeWhenWedgedNextToTheDoorWall) {
   // Just through the door, heading -54 deg, the rear right corner 8 cm from
   // the door wall below the jamb (office, seed 3: wedged in a doorway). The
@@ -108,8 +114,12 @@ TEST(ExplorerClosedLoopTest, GetsFreeWhenWedgedNextToTheDoorWall) {
   EXPECT_EQ(result.contacts, 0);
 }
 
+// A door too narrow for the robot (0.55 m: the wheels make it 0.525 m wide
+// and paths keep 0.32 m clearance): the explorer explores its own room, does
+// not circle in front of the door, and ends with `unreachable` well before
+// the time limit.
 TEST(ExplorerClosedLoopTest, EndsUnreachableBehindANarrowDoor) {
-  const EpisodeResult result = RunEpisode(Pose2(1.5, 1.0, 0.3), 600.0, 0.7);
+  const EpisodeResult result = RunEpisode(Pose2(1.5, 1.0, 0.3), 600.0, 0.55);
   std::printf("narrow door: finished %d (%s) at t = %.1f s, explored %.3f, contacts %d\n",
               result.finished, result.reason.c_str(), result.t_s, result.explored,
               result.contacts);
@@ -120,6 +130,47 @@ TEST(ExplorerClosedLoopTest, EndsUnreachableBehindANarrowDoor) {
   // The first room (half the area) is seen, and some of the second
   // through the door.
   EXPECT_GT(result.explored, 0.5);
+}
+
+// A corridor of 10 x 1.6 m with a room of 4 x 4 m above it, entered by a
+// door of `door_width_m` (thin walls) in the middle of the corridor's wall;
+// a partition across the room from its left wall (y = 3.8, x in [3, 5.2])
+// hides the room's far left part from the door.
+std::vector<Wall> CorridorAndRoom(double door_width_m) {
+  std::vector<Wall> walls = {
+      {{0.0, 0.0}, {10.0, 0.0}},
+      {{0.0, 0.0}, {0.0, 1.6}},
+      {{10.0, 0.0}, {10.0, 1.6}},
+      {{0.0, 1.6}, {5.0 - 0.5 * door_width_m, 1.6}},
+      {{5.0 + 0.5 * door_width_m, 1.6}, {10.0, 1.6}},
+  };
+  for (const Wall& wall : Box(3.0, 1.6, 7.0, 5.6)) {
+    if (wall.a.y() != 1.6 || wall.b.y() != 1.6) walls.push_back(wall);
+  }
+  walls.push_back({{3.0, 3.8}, {5.2, 3.8}});
+  return walls;
+}
+
+// Standard doors: the robot starts at the end of the corridor, facing away
+// from the door; the only unexplored space is the room behind a 0.8 m (and a
+// 0.9 m) door. It must enter the room (its whole body, 0.47 m behind h, past
+// the door), see at least 99 % of the reachable area (behind the partition
+// too) and end `no_frontier`, without a contact.
+TEST(ExplorerClosedLoopTest, EntersARoomThroughAStandardDoor) {
+  for (const double door_width_m : {0.8, 0.9}) {
+    const std::vector<Wall> walls = CorridorAndRoom(door_width_m);
+    const EpisodeResult result = RunEpisodeIn(walls, walls, Pose2(1.0, 0.8, kPi), 400.0);
+    double deepest_y = 0.0;
+    for (const Eigen::Vector2d& p : result.positions_W) deepest_y = std::max(deepest_y, p.y());
+    std::printf("door %.2f m: %s after %.1f s, %.1f %% seen, deepest y %.2f m, %d contacts\n",
+                door_width_m, result.reason.c_str(), result.t_s, 100.0 * result.explored,
+                deepest_y, result.contacts);
+    EXPECT_TRUE(result.finished);
+    EXPECT_EQ(result.reason, "no_frontier");
+    EXPECT_GE(deepest_y, 1.6 + 0.5);
+    EXPECT_GE(result.explored, 0.99);
+    EXPECT_EQ(result.contacts, 0);
+  }
 }
 
 // The log rows follow the explorer's state: frontier points, the goal, the

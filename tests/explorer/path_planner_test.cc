@@ -133,8 +133,10 @@ TEST(PathPlannerTest, ClearanceIsTheDistanceToTheNearestOccupiedCell) {
   const ExplorerParams params;
   const OccupancyGrid grid = MappedLCorridor();
   const NavigationMap map(grid, params, {1.0, 1.0});
-  // In the 2 m corridor, 1 m from both walls: about 1 m (within a cell).
-  EXPECT_NEAR(map.ClearanceAt({2.0, 1.0}), 1.0, 1.5 * grid.resolution());
+  // In the 2 m corridor, 1 m from both walls: capped at the preferred
+  // clearance (0.9 m), nothing reads more.
+  EXPECT_EQ(map.ClearanceAt({2.0, 1.0}), static_cast<float>(ClearanceCapM(params)));
+  EXPECT_NEAR(map.ClearanceAt({2.0, 0.7}), 0.7, 1.5 * grid.resolution());
   EXPECT_NEAR(map.ClearanceAt({2.0, 0.4}), 0.4, 1.5 * grid.resolution());
   EXPECT_TRUE(map.TraversableAt({2.0, 1.0}));
   EXPECT_FALSE(map.TraversableAt({2.0, 0.3}));  // too close to the wall
