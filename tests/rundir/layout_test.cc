@@ -102,6 +102,7 @@ TEST(LayoutTest, DocumentedColumnsOfTheOtherFilesAreTheWrittenOnes) {
   EXPECT_EQ(DocumentedColumns(docs, "## `scans.csv`"), ScanColumns(181));
   EXPECT_EQ(DocumentedColumns(docs, "## `explorer.csv`"), ExplorerColumns());
   EXPECT_EQ(DocumentedColumns(docs, "## Map CSVs"), MapColumns());
+  EXPECT_EQ(DocumentedColumns(docs, "## `reference.csv` (imported logs)"), ReferenceColumns());
   EXPECT_EQ(DocumentedColumns(docs, "## `divergence.csv`"), DivergenceColumns());
   EXPECT_EQ(DocumentedColumns(docs, "## `nees.csv` (sweep directory)"), NeesColumns());
 }
