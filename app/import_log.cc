@@ -124,7 +124,8 @@ Pose2 OdometryAt(const std::vector<OdometryMessage>& odometry, double t_s) {
 bool PosesDifferFromOdometry(const std::vector<LaserMessage>& scans,
                              const std::vector<OdometryMessage>& odometry) {
   for (const LaserMessage& scan : scans) {
-    const Pose2 odom = OdometryAt(odometry, scan.t_s);
+    const Pose2 odom =
+        scan.has_odometry_at_scan ? scan.odometry_at_scan : OdometryAt(odometry, scan.t_s);
     if ((scan.robot_pose.translation() - odom.translation()).norm() > kReferenceDistanceM ||
         std::abs(WrapAngle(scan.robot_pose.theta - odom.theta)) > kReferenceAngleRad) {
       return true;
@@ -201,7 +202,11 @@ int WriteRecording(const Stream& s, const std::string& dir) {
     const double t = std::min(t_odom, t_scan);
     if (t_odom == t) last = &s.odometry[o++];
     if (t_scan == t) ++k;
-    const Pose2 X_WR = s.X_WO * OdometryAt(s.odometry, t) * s.X_BR;
+    const LaserMessage* scan = t_scan == t ? s.scans[k - 1] : nullptr;
+    const Pose2 X_OB = scan != nullptr && scan->has_odometry_at_scan
+                           ? scan->odometry_at_scan
+                           : OdometryAt(s.odometry, t);
+    const Pose2 X_WR = s.X_WO * X_OB * s.X_BR;
     for (double value : {t, nan, nan, nan, X_WR.x, X_WR.y, X_WR.theta, last->tv_mps,
                          last->rv_radps}) {
       trajectory.Add(value);
@@ -250,7 +255,10 @@ ImportReport ImportLog(RunConfig config, const ImportOptions& options) {
   const double t0 = s.scans.front()->t_s;
   if (s.has_reference) {
     const Pose2 X_WB0 = s.scans.front()->laser_pose * s.X_BS.Inverse();
-    s.X_WO = X_WB0 * OdometryAt(s.odometry, t0).Inverse();
+    const LaserMessage& scan0 = *s.scans.front();
+    s.X_WO = X_WB0 * (scan0.has_odometry_at_scan ? scan0.odometry_at_scan
+                                                  : OdometryAt(s.odometry, t0))
+                         .Inverse();
   }
 
   ImportReport report;

@@ -205,6 +205,10 @@ CarmenLog ReadCarmenLog(const std::string& path, const CarmenReadOptions& option
   log.path = path;
   LineReader reader(path);
   std::string line;
+  // The last ODOM message read, kept or not, and whether it is the message
+  // just before the current line.
+  OdometryMessage last_odom;
+  bool odom_just_before = false;
   while (reader.Next(&line)) {
     const int line_number = ++log.num_lines;
     std::vector<std::string> tokens = SplitTokens(line);
@@ -220,6 +224,9 @@ CarmenLog ReadCarmenLog(const std::string& path, const CarmenReadOptions& option
         OdometryMessage odom = ParseOdom(fields);
         odom.line = line_number;
         Keep(odom, kind, &log.odometry, &log);
+        last_odom = odom;
+        odom_just_before = true;
+        continue;
       } else if (kind == "FLASER" || kind == "RLASER" || IsNewLaser(kind, "RAWLASER") ||
                  IsNewLaser(kind, "ROBOTLASER")) {
         LaserMessage laser =
@@ -228,13 +235,17 @@ CarmenLog ReadCarmenLog(const std::string& path, const CarmenReadOptions& option
                 : ParseNewLaser(fields, kind[1] == 'O', options.max_range_m);
         laser.kind = kind;
         laser.line = line_number;
+        laser.has_odometry_at_scan = odom_just_before && last_odom.t_s == laser.t_s;
+        laser.odometry_at_scan = last_odom.pose;
         Keep(laser, kind, &log.lasers[kind], &log);
       } else {
         ++log.skipped[kind + ": not read"];
       }
+      odom_just_before = false;
     } catch (const BadLine& bad) {
       const std::string message = path + ":" + std::to_string(line_number) + ": " + bad.what();
       if (!options.skip_bad_lines) throw std::runtime_error(message);
+      odom_just_before = false;
       ++log.skipped["bad line"];
       if (log.bad_lines.size() < kMaxBadLinesKept) log.bad_lines.push_back(message);
     }

@@ -44,6 +44,11 @@ struct LaserMessage {
   /// (CARMEN's "odometry" triple of FLASER, the robot pose of ROBOTLASER).
   Pose2 laser_pose;
   Pose2 robot_pose;
+  /// Whether the ODOM message just before it in the log has its timestamp
+  /// (the corrected logs write the raw odometry of each scan so), and that
+  /// message's pose: the odometry at the scan, whatever the clock's jitter.
+  bool has_odometry_at_scan = false;
+  Pose2 odometry_at_scan;
   /// Line of the log it came from (1-based).
   int line = 0;
 };

@@ -122,7 +122,8 @@ TEST(LayoutTest, EveryFileIsDocumented) {
   const std::string docs = ReadDocs();
   for (const std::string file :
        {kConfigFile, kManifestFile, kSummaryFile, kTrajectoryFile, kScansFile, kExplorerFile,
-        kGroundTruthMapFile, kDivergenceFile, kVideoFile, kFinalImageFile, kNeesFile}) {
+        kGroundTruthMapFile, kDivergenceFile, kVideoFile, kFinalImageFile, kNeesFile,
+        kReferenceFile}) {
     EXPECT_NE(docs.find("`" + file + "`"), std::string::npos) << file;
   }
   for (const std::string& name : FilterNames()) {
