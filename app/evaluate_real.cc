@@ -1,8 +1,11 @@
 #include "app/evaluate_real.h"
 
+#include <algorithm>
 #include <cmath>
 #include <set>
 #include <stdexcept>
+
+#include <Eigen/Eigenvalues>
 
 #include "app/run_config.h"
 #include "rundir/csv_reader.h"
@@ -56,23 +59,23 @@ nlohmann::json ToJson(const std::vector<ScoredTrajectory>& scored) {
   return out;
 }
 
-// Rows whose pose covariance of filter `name` is not symmetric positive
-// definite (the columns hold the upper triangle: symmetric by construction;
-// positive definite by its leading minors).
-int NotPositiveDefinite(const rundir::CsvTable& table, const std::string& name) {
+// Counts the rows whose pose covariance of filter `name` is not positive
+// semi-definite, and those where it is singular (the columns hold the upper
+// triangle: symmetric by construction).
+std::pair<int, int> CovarianceDefects(const rundir::CsvTable& table, const std::string& name) {
   const int c = Column(table, name + "_pxx");
-  int bad = 0;
+  int not_psd = 0, singular = 0;
   for (const std::vector<double>& row : table.rows) {
-    const double xx = row[c], xy = row[c + 1], xt = row[c + 2], yy = row[c + 3],
-                 yt = row[c + 4], tt = row[c + 5];
-    const double m2 = xx * yy - xy * xy;
-    const double m3 = xx * (yy * tt - yt * yt) - xy * (xy * tt - yt * xt) +
-                      xt * (xy * yt - yy * xt);
-    // The known start (P = 0) is the one exception the filter starts from.
-    const bool zero = xx == 0.0 && yy == 0.0 && tt == 0.0;
-    if (!zero && !(xx > 0.0 && m2 > 0.0 && m3 > 0.0)) ++bad;
+    Eigen::Matrix3d P;
+    P << row[c], row[c + 1], row[c + 2], row[c + 1], row[c + 3], row[c + 4], row[c + 2],
+        row[c + 4], row[c + 5];
+    const Eigen::Vector3d eigenvalues = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(P,
+        Eigen::EigenvaluesOnly).eigenvalues();
+    const double scale = std::max(eigenvalues.cwiseAbs().maxCoeff(), 1e-300);
+    if (!P.allFinite() || eigenvalues.minCoeff() < -1e-9 * scale) ++not_psd;
+    else if (eigenvalues.minCoeff() <= 1e-9 * scale) ++singular;
   }
-  return bad;
+  return {not_psd, singular};
 }
 
 }  // namespace
@@ -146,7 +149,9 @@ RealEvaluation EvaluateImportedRun(const std::string& run_dir) {
     }
   }
   for (const std::string& name : rundir::FilterNames()) {
-    result.not_positive_definite.push_back(NotPositiveDefinite(trajectory, name));
+    const auto [not_psd, singular] = CovarianceDefects(trajectory, name);
+    result.not_positive_semidefinite.push_back(not_psd);
+    result.singular.push_back(singular);
     result.num_features.push_back(static_cast<int>(
         rundir::ReadCsv(rundir::PathIn(run_dir, rundir::MapFile(name)), {"type"}).rows.size()));
   }
@@ -161,7 +166,8 @@ RealEvaluation EvaluateImportedRun(const std::string& run_dir) {
                      {"relations_at_scans", ToJson(result.at_scans)},
                      {"relations_at_records", ToJson(result.at_records)},
                      {"vs_reference_consecutive_scans", ToJson(result.vs_reference)},
-                     {"pose_covariance_not_pd_rows", result.not_positive_definite},
+                     {"pose_covariance_not_psd_rows", result.not_positive_semidefinite},
+                     {"pose_covariance_singular_rows", result.singular},
                      {"num_features", result.num_features}};
   rundir::WriteJsonAtomically(summary_path, summary);
   return result;

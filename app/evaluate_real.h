@@ -35,8 +35,12 @@ struct RealEvaluation {
   double time_offset_s = 0.0;
   double tolerance_s = 0.0;
   /// Per filter (classical, selective): rows whose pose covariance is not
-  /// symmetric positive definite, and the final map size.
-  std::vector<int> not_positive_definite;
+  /// positive semi-definite (an eigenvalue below -1e-9 of the largest), rows
+  /// where it is singular (the smallest eigenvalue at most 1e-9 of the
+  /// largest: the known start, and the first steps, before a turn makes the
+  /// lateral direction uncertain), and the final map size.
+  std::vector<int> not_positive_semidefinite;
+  std::vector<int> singular;
   std::vector<int> num_features;
 };
 

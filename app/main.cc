@@ -274,9 +274,10 @@ int EvaluateImportedMain(const std::string& run_dir) {
   print("relations file, poses at every record:", result.at_records);
   print("reference, consecutive scans:", result.vs_reference);
   for (std::size_t f = 0; f < result.num_features.size(); ++f) {
-    std::printf("%s: %d features, %d rows with a pose covariance not positive definite\n",
+    std::printf("%s: %d features; pose covariance not positive semi-definite in %d rows, "
+                "singular in %d\n",
                 rundir::FilterNames()[f].c_str(), result.num_features[f],
-                result.not_positive_definite[f]);
+                result.not_positive_semidefinite[f], result.singular[f]);
   }
   return 0;
 }
