@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <memory>
 #include <stdexcept>
 
@@ -177,7 +178,7 @@ std::vector<double> SlamRanges(const LaserMessage& scan) {
 // recorded columns, one row per odometry message and per scan in time order.
 int WriteRecording(const Stream& s, const std::string& dir) {
   const int num_beams = static_cast<int>(s.scans.front()->ranges_m.size());
-  const double nan = 0.0 / 0.0;
+  const double nan = std::numeric_limits<double>::quiet_NaN();
   rundir::CsvWriter scans(rundir::PathIn(dir, rundir::kScansFile), rundir::ScanColumns(num_beams));
   std::unique_ptr<rundir::CsvWriter> reference;
   if (s.has_reference) {
@@ -220,11 +221,40 @@ int WriteRecording(const Stream& s, const std::string& dir) {
   return rows;
 }
 
+// The manifest of an imported run: the source, the layout, the counts, the
+// reference and the relations' matching.
+nlohmann::json ManifestFields(const ImportOptions& options, const ImportReport& report,
+                              const LaserMessage& first, const Stream& s) {
+  nlohmann::json skipped = nlohmann::json::array();
+  for (const std::string& line : report.skipped) skipped.push_back(line);
+  return {{"mode", "import"},
+          {"source_log", options.log_path},
+          {"source_hash", rundir::HashFile(options.log_path)},
+          {"laser_message", first.kind},
+          {"num_beams", report.num_beams},
+          {"angle_min_deg", first.angle_min_rad * kRadToDeg},
+          {"angle_step_deg", first.angle_increment_rad * kRadToDeg},
+          {"max_range_m", first.max_range_m},
+          {"laser_offset_m", s.X_BS.x},
+          {"num_scans", report.num_scans},
+          {"num_odometry", report.num_odometry},
+          {"skipped", skipped},
+          {"reference", s.has_reference ? "reference.csv: the log's own pose estimate (a SLAM "
+                                          "result, not ground truth)"
+                                        : "none"},
+          {"relations_file", options.relations_path},
+          {"relations_time_offset_s", report.time_offset_s},
+          {"relations_tolerance_s", options.tolerance_s},
+          {"mjslam_version", MjslamVersion()},
+          {"git_commit", MjslamGitCommit()},
+          {"config_file", options.config_path},
+          {"command_line", options.command_line}};
+}
+
 }  // namespace
 
 // Reads the log, sets the config's laser from it, writes the recording and
-// the manifest, then replays the recording into the same directory. Longer
-// than most: it is the command's outline, each step a call or a few lines.
+// the manifest, then replays the recording into the same directory.
 ImportReport ImportLog(RunConfig config, const ImportOptions& options) {
   const CarmenLog log = realdata::ReadCarmenLog(options.log_path, options.read);
   const std::vector<LaserMessage>& all_scans = ChooseLaser(log, options.laser);
@@ -283,31 +313,7 @@ ImportReport ImportLog(RunConfig config, const ImportOptions& options) {
   const std::string& dir = options.out_dir;
   const rundir::RunDirectoryLock lock(dir);
   rundir::WriteFileAtomically(rundir::PathIn(dir, rundir::kConfigFile), config::ToYaml(config));
-  nlohmann::json skipped = nlohmann::json::array();
-  for (const std::string& line : report.skipped) skipped.push_back(line);
-  rundir::ManifestWriter manifest(
-      dir, {{"mode", "import"},
-            {"source_log", options.log_path},
-            {"source_hash", rundir::HashFile(options.log_path)},
-            {"laser_message", first.kind},
-            {"num_beams", num_beams},
-            {"angle_min_deg", first.angle_min_rad * kRadToDeg},
-            {"angle_step_deg", first.angle_increment_rad * kRadToDeg},
-            {"max_range_m", first.max_range_m},
-            {"laser_offset_m", s.X_BS.x},
-            {"num_scans", report.num_scans},
-            {"num_odometry", report.num_odometry},
-            {"skipped", skipped},
-            {"reference", s.has_reference ? "reference.csv: the log's own pose estimate (a SLAM "
-                                            "result, not ground truth)"
-                                          : "none"},
-            {"relations_file", options.relations_path},
-            {"relations_time_offset_s", report.time_offset_s},
-            {"relations_tolerance_s", options.tolerance_s},
-            {"mjslam_version", MjslamVersion()},
-            {"git_commit", MjslamGitCommit()},
-            {"config_file", options.config_path},
-            {"command_line", options.command_line}});
+  rundir::ManifestWriter manifest(dir, ManifestFields(options, report, first, s));
   manifest.SetLaserMount(s.X_BR.Inverse() * s.X_BS);
   manifest.Write();
   report.num_steps = WriteRecording(s, dir);

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -23,7 +24,7 @@ struct ImportOptions {
   std::string laser;
   /// Distance of the laser ahead of the robot centre, metres; NaN: the log's
   /// PARAM robot_frontlaser_offset (robot_rearlaser_offset for RLASER), or 0.
-  double laser_offset_m = 0.0 / 0.0;
+  double laser_offset_m = std::numeric_limits<double>::quiet_NaN();
   /// Whether the laser messages' poses are the reference trajectory: "auto"
   /// (when they are not the odometry: more than 5 cm or 0.05 rad from it at
   /// some scan), "yes" or "no".
@@ -33,7 +34,7 @@ struct ImportOptions {
   /// realdata::BestTimeOffset) and the matching tolerance, seconds. Kept in
   /// the manifest for `mjslam evaluate`.
   std::string relations_path;
-  double time_offset_s = 0.0 / 0.0;
+  double time_offset_s = std::numeric_limits<double>::quiet_NaN();
   double tolerance_s = 0.006;
 };
 
