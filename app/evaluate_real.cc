@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <set>
 #include <stdexcept>
 
@@ -83,7 +84,24 @@ std::pair<int, int> CovarianceDefects(const rundir::CsvTable& table, const std::
 bool IsImportedRun(const std::string& run_dir) {
   const nlohmann::json manifest =
       rundir::ReadJsonFile(rundir::PathIn(run_dir, rundir::kManifestFile), nlohmann::json::object());
-  return manifest.value("mode", std::string()) == "import";
+  const std::string mode = manifest.value("mode", std::string());
+  if (mode == "import") return true;
+  if (mode != "replay") return false;
+  // A replay of an imported run.
+  const std::string scans = manifest.value("scans_file", std::string());
+  const std::string source_dir = std::filesystem::path(scans).parent_path().string();
+  const nlohmann::json source = rundir::ReadJsonFile(
+      rundir::PathIn(source_dir.empty() ? "." : source_dir, rundir::kManifestFile),
+      nlohmann::json::object());
+  return source.value("mode", std::string()) == "import";
+}
+
+std::string ImportedScansPath(const std::string& run_dir) {
+  const nlohmann::json manifest = rundir::ReadManifest(run_dir);
+  if (manifest.value("mode", std::string()) == "replay") {
+    return manifest.value("scans_file", std::string());
+  }
+  return rundir::PathIn(run_dir, rundir::kScansFile);
 }
 
 // Reads the files, scores each trajectory on each set of relations and
@@ -93,7 +111,7 @@ RealEvaluation EvaluateImportedRun(const std::string& run_dir) {
   const RunConfig config = LoadRunConfig(rundir::PathIn(run_dir, rundir::kConfigFile), {});
   const Pose2 X_RB(-config.slam.ekf.control_point_offset_m, 0.0, 0.0);
   const rundir::CsvTable trajectory = rundir::ReadCsv(rundir::PathIn(run_dir, rundir::kTrajectoryFile));
-  const rundir::CsvTable scans = rundir::ReadCsv(rundir::PathIn(run_dir, rundir::kScansFile));
+  const rundir::CsvTable scans = rundir::ReadCsv(ImportedScansPath(run_dir));
   std::set<double> scan_times;
   for (const std::vector<double>& row : scans.rows) scan_times.insert(row[0]);
 

@@ -7,8 +7,14 @@
 
 namespace mjslam::app {
 
-/// Whether `run_dir` was written by `mjslam import` (manifest mode "import").
+/// Whether `run_dir` was written by `mjslam import` (manifest mode "import"),
+/// or is a replay of such a run (its scans_file lies in one). A replay keeps
+/// no relations file or reference: evaluating it checks the covariances only.
 bool IsImportedRun(const std::string& run_dir);
+
+/// The scans.csv of an imported run: its own, or for a replay of one the
+/// manifest's scans_file.
+std::string ImportedScansPath(const std::string& run_dir);
 
 /// The relation metric of one trajectory on one set of relations.
 struct ScoredTrajectory {

@@ -5,6 +5,7 @@
 #include <map>
 #include <stdexcept>
 
+#include "app/evaluate_real.h"
 #include "app/run_config.h"
 #include "renders/plan_canvas.h"
 #include "renders/video_writer.h"
@@ -67,7 +68,7 @@ RealRun ReadRealRun(const std::string& dir) {
   if (!mount) throw std::runtime_error(rundir::PathIn(dir, rundir::kManifestFile) + ": no laser_mount");
   run.X_RS = *mount;
   run.trajectory = rundir::ReadCsv(rundir::PathIn(dir, rundir::kTrajectoryFile));
-  run.scans = rundir::ReadCsv(rundir::PathIn(dir, rundir::kScansFile));
+  run.scans = rundir::ReadCsv(ImportedScansPath(dir));
   for (std::size_t i = 0; i < run.trajectory.rows.size(); ++i) {
     run.row_at[run.trajectory.rows[i][0]] = i;
   }
