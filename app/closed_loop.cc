@@ -81,7 +81,11 @@ ClosedLoop::ClosedLoop(const RunConfig& config)
 
 ClosedLoop::ClosedLoop(const RunConfig& config, const rundir::Recording& recording)
     : config_(config), recording_(&recording), dt_s_(1.0 / config.run.control_rate_hz) {
-  const Pose2& X_WR0 = recording.Step(0).X_WR_true;
+  // A recording without a true pose (a real log) starts at its odometry pose.
+  const rundir::RecordedStep first = recording.Step(0);
+  const bool has_truth = std::isfinite(first.X_WR_true.x) && std::isfinite(first.X_WR_true.y) &&
+                         std::isfinite(first.X_WR_true.theta);
+  const Pose2& X_WR0 = has_truth ? first.X_WR_true : first.X_WR_odometry;
   X_WR0_ = Pose2(X_WR0.x, X_WR0.y, X_WR0.theta);
   X_RS_ = recording.X_RS();
   slam_.emplace(config_.slam, config_.control, dt_s_, X_WR0_, X_RS_, Rng(config_.run.seed));

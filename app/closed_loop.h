@@ -52,7 +52,8 @@ class ClosedLoop {
   /// for a bad world or robot; `config` must be valid.
   explicit ClosedLoop(const RunConfig& config);
   /// The recorded loop: both filters on the records rebuilt from
-  /// `recording` (true start pose, odometry, held commands, scans laid out
+  /// `recording` (true start pose, or the first odometry pose of a recording
+  /// without truth such as an imported log; odometry, held commands, scans laid out
   /// as config.laser says; ranges at the maximum are no-return). `recording`
   /// must outlive the loop.
   ClosedLoop(const RunConfig& config, const rundir::Recording& recording);

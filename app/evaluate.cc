@@ -88,13 +88,18 @@ RunEvaluation EvaluateRunDirectory(const std::string& run_dir, const EvaluateOpt
   options.match.ValidateOrThrow();
   options.divergence.ValidateOrThrow();
   const nlohmann::json manifest = rundir::ReadManifest(run_dir);
+  const CsvTable trajectory = rundir::ReadCsv(rundir::PathIn(run_dir, rundir::kTrajectoryFile));
+  if (trajectory.rows.empty()) throw std::runtime_error(trajectory.path + ": no rows");
+  // A recording without truth (a real log) has no world to compare with.
+  if (std::isnan(trajectory.rows[0][1])) {
+    throw std::runtime_error(trajectory.path + ": true_x is nan: no true pose to evaluate against "
+                             "(a real log: evaluate the directory mjslam import wrote)");
+  }
   RunEvaluation result;
   result.truth = RunGroundTruth(run_dir, options.ground_truth);
   rundir::WriteMapCsv(rundir::PathIn(run_dir, rundir::kGroundTruthMapFile), result.truth);
 
   // Poses and maps of both filters.
-  const CsvTable trajectory = rundir::ReadCsv(rundir::PathIn(run_dir, rundir::kTrajectoryFile));
-  if (trajectory.rows.empty()) throw std::runtime_error(trajectory.path + ": no rows");
   std::vector<eval::Map> maps;
   for (const std::string& name : FilterNames()) {
     std::vector<eval::PoseStepMetrics> steps = PoseSteps(trajectory, name);

@@ -3,10 +3,12 @@
 // place that catches errors.
 #include <csignal>
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <filesystem>
 #include <functional>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -14,6 +16,9 @@
 
 #include "app/cpu_profile.h"
 #include "app/evaluate.h"
+#include "app/evaluate_real.h"
+#include "app/import_log.h"
+#include "app/render_real.h"
 #include "app/render_run.h"
 #include "app/replay.h"
 #include "app/run.h"
@@ -163,6 +168,66 @@ int ReplayMain(ReplayCommand c, const std::string& command_line) {
   return 0;
 }
 
+// mjslam import
+struct ImportCommand {
+  ConfigOptions config;
+  ImportOptions options;
+  std::string time_offset = "auto";
+};
+
+CLI::App* AddImport(CLI::App* cli, ImportCommand* c) {
+  c->config.path = std::string(MJSLAM_SOURCE_DIR) + "/configs/real.yaml";
+  CLI::App* import = cli->add_subcommand(
+      "import", "Import a CARMEN laser log (plain or gzip) into a run directory and run both filters on it");
+  import->add_option("LOG", c->options.log_path, "CARMEN log")->required();
+  import->add_option("--out", c->options.out_dir, "Output run directory")->required();
+  import->add_option("--laser", c->options.laser,
+                     "Laser messages to use (FLASER, RLASER, ROBOTLASER1, RAWLASER1, ...) [first found]");
+  import->add_option("--angle-min-deg", c->options.read.angle_min_deg,
+                     "FLASER/RLASER: bearing of beam 0, degrees")->capture_default_str();
+  import->add_option("--angle-step-deg", c->options.read.angle_step_deg,
+                     "FLASER/RLASER: step between beams, degrees (0: from the beam count)")
+      ->capture_default_str();
+  import->add_option("--max-range", c->options.read.max_range_m,
+                     "Maximum range, metres (0: from the log, else 81.83)")->capture_default_str();
+  import->add_option("--laser-offset", c->options.laser_offset_m,
+                     "Laser ahead of the robot centre, metres [PARAM robot_frontlaser_offset, or 0]");
+  import->add_option("--reference", c->options.reference,
+                     "The laser poses as reference trajectory: auto, yes, no")->capture_default_str();
+  import->add_flag("--skip-bad-lines", c->options.read.skip_bad_lines,
+                   "Count and report malformed lines instead of stopping at the first");
+  import->add_option("--relations", c->options.relations_path, "Relations file (Kuemmerle et al. 2009)");
+  import->add_option("--time-offset", c->time_offset,
+                     "Relation time minus log time, seconds, or auto (searched)")->capture_default_str();
+  import->add_option("--tolerance", c->options.tolerance_s,
+                     "Relation time matching tolerance, seconds")->capture_default_str();
+  AddConfigOptions(import, &c->config, "Override any config key");
+  return import;
+}
+
+int ImportMain(ImportCommand c, const std::string& command_line) {
+  const RunConfig config = LoadRunConfig(c.config.path, c.config.overrides);
+  c.options.config_path = c.config.path;
+  c.options.command_line = command_line;
+  if (c.time_offset != "auto") {
+    char* end = nullptr;
+    c.options.time_offset_s = std::strtod(c.time_offset.c_str(), &end);
+    if (end == c.time_offset.c_str() || *end != '\0') {
+      throw std::runtime_error("--time-offset: expected seconds or auto (got '" + c.time_offset + "')");
+    }
+  }
+  const ImportReport report = ImportLog(config, c.options);
+  std::fprintf(stderr, "%s: imported %s: %d %s scans of %d beams, %d odometry messages, %d steps, %s\n",
+               c.options.out_dir.c_str(), c.options.log_path.c_str(), report.num_scans,
+               report.laser.c_str(), report.num_beams, report.num_odometry, report.num_steps,
+               report.has_reference ? "reference trajectory (the log's own estimate)" : "no reference");
+  for (const std::string& line : report.skipped) std::fprintf(stderr, "  skipped %s\n", line.c_str());
+  if (!c.options.relations_path.empty()) {
+    std::fprintf(stderr, "  relations time offset %.6f s\n", report.time_offset_s);
+  }
+  return 0;
+}
+
 // mjslam config
 CLI::App* AddConfig(CLI::App* cli, ConfigOptions* c) {
   CLI::App* show =
@@ -196,7 +261,38 @@ CLI::App* AddEvaluate(CLI::App* cli, EvaluateCommand* c) {
   return evaluate;
 }
 
+// An imported log: the relation metric instead of the world's truth.
+int EvaluateImportedMain(const std::string& run_dir) {
+  const RealEvaluation result = EvaluateImportedRun(run_dir);
+  auto print = [](const char* title, const std::vector<ScoredTrajectory>& scored) {
+    if (scored.empty()) return;
+    std::printf("%s\n%-10s %8s %11s %10s %11s %10s\n", title, "", "matched", "trans_mean_m",
+                "trans_std_m", "rot_mean_deg", "rot_std_deg");
+    for (const ScoredTrajectory& s : scored) {
+      std::printf("%-10s %8d %11.4f %10.4f %11.3f %10.3f\n", s.name.c_str(), s.errors.num_matched,
+                  s.errors.translation_mean_m, s.errors.translation_std_m,
+                  s.errors.rotation_mean_deg, s.errors.rotation_std_deg);
+    }
+  };
+  if (result.relation_times > 0) {
+    std::printf("relation timestamps on scans: %d of %d (offset %.6f s, tolerance %.4f s)\n",
+                result.relation_times_at_scans, result.relation_times, result.time_offset_s,
+                result.tolerance_s);
+  }
+  print("relations file, poses at scans:", result.at_scans);
+  print("relations file, poses at every record:", result.at_records);
+  print("reference, consecutive scans:", result.vs_reference);
+  for (std::size_t f = 0; f < result.num_features.size(); ++f) {
+    std::printf("%s: %d features; pose covariance not positive semi-definite in %d rows, "
+                "singular in %d\n",
+                rundir::FilterNames()[f].c_str(), result.num_features[f],
+                result.not_positive_semidefinite[f], result.singular[f]);
+  }
+  return 0;
+}
+
 int EvaluateMain(const EvaluateCommand& c) {
+  if (IsImportedRun(c.run_dir)) return EvaluateImportedMain(c.run_dir);
   const RunEvaluation result = EvaluateRunDirectory(c.run_dir, c.options);
   std::printf("%-10s %8s %8s %8s %9s %8s %9s %6s %6s\n", "filter", "in2s_x", "in2s_y", "in2s_th",
               "mean_nees", "matched", "dupl", "unm", "incons");
@@ -464,6 +560,11 @@ int RenderMain(RenderCommand c) {
   }
   c.params.video = !c.no_video;
   c.params.plots = !c.no_plots;
+  if (IsImportedRun(c.dir)) {
+    const int frames = RenderImportedRun(c.dir, c.params);
+    std::fprintf(stderr, "%s: rendered (final.png, %d video frames)\n", c.dir.c_str(), frames);
+    return 0;
+  }
   RenderOptions options;
   options.show_progress = !c.quiet;
   options.stop_requested = &g_stop_requested;
@@ -483,6 +584,7 @@ int main(int argc, char** argv) {
   cli.require_subcommand(1);
   app::RunCommand run;
   app::ReplayCommand replay;
+  app::ImportCommand import;
   app::ConfigOptions config;
   app::EvaluateCommand evaluate;
   app::SweepCommand sweep;
@@ -494,6 +596,7 @@ int main(int argc, char** argv) {
   const std::vector<std::pair<CLI::App*, std::function<int()>>> commands = {
       {app::AddRun(&cli, &run), [&] { return app::RunMain(*cli.get_subcommand("run"), run, command_line); }},
       {app::AddReplay(&cli, &replay), [&] { return app::ReplayMain(replay, command_line); }},
+      {app::AddImport(&cli, &import), [&] { return app::ImportMain(import, command_line); }},
       {app::AddConfig(&cli, &config), [&] { return app::ConfigMain(config); }},
       {app::AddEvaluate(&cli, &evaluate), [&] { return app::EvaluateMain(evaluate); }},
       {app::AddSweep(&cli, &sweep), [&] { return app::SweepMain(*cli.get_subcommand("sweep"), sweep); }},

@@ -30,6 +30,13 @@ void Replay(const RunConfig& config, const ReplayOptions& options) {
                                         {"git_commit", MjslamGitCommit()},
                                         {"config_file", options.config_path},
                                         {"command_line", options.command_line}});
+  ReplayRecording(config, recording, dir, &manifest);
+}
+
+void ReplayRecording(const RunConfig& config, const rundir::Recording& recording,
+                     const std::string& dir, rundir::ManifestWriter* manifest) {
+  manifest->SetLaserMount(recording.X_RS());
+  manifest->Write();
   try {
     // The same loop as a run, its records read from the recording.
     ClosedLoop loop(config, recording);
@@ -45,10 +52,10 @@ void Replay(const RunConfig& config, const ReplayOptions& options) {
     trajectory.Flush();
     WriteMaps(loop.slam(), dir);
   } catch (const std::exception& error) {
-    manifest.Fail(error.what());
+    manifest->Fail(error.what());
     throw;
   }
-  manifest.Finish("completed");
+  manifest->Finish("completed");
 }
 
 }  // namespace mjslam::app

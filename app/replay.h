@@ -3,6 +3,8 @@
 #include <string>
 
 #include "app/run_config.h"
+#include "rundir/manifest.h"
+#include "rundir/recording.h"
 
 namespace mjslam::app {
 
@@ -28,5 +30,14 @@ struct ReplayOptions {
 /// of the original run except the timings. Throws std::runtime_error naming
 /// the file, line and column of bad input.
 void Replay(const RunConfig& config, const ReplayOptions& options);
+
+/// The part of Replay after its inputs are read, for `mjslam replay` and
+/// `mjslam import`: runs both filters over `recording` and writes
+/// trajectory.csv and the maps into `dir` (locked by the caller), records
+/// the laser mount in `manifest` (so that the directory can be replayed in
+/// turn) and finishes it ("completed", or "failed" with the error, which is
+/// rethrown).
+void ReplayRecording(const RunConfig& config, const rundir::Recording& recording,
+                     const std::string& dir, rundir::ManifestWriter* manifest);
 
 }  // namespace mjslam::app

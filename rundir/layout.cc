@@ -46,6 +46,8 @@ std::vector<std::string> ScanColumns(int num_beams) {
 
 std::vector<std::string> ExplorerColumns() { return {"t", "kind", "index", "x", "y"}; }
 
+std::vector<std::string> ReferenceColumns() { return {"t", "x", "y", "th"}; }
+
 std::vector<std::string> MapColumns() {
   return {"id", "type", "p0", "p1", "c00", "c01", "c11", "ax", "ay", "bx", "by"};
 }

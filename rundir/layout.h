@@ -20,6 +20,9 @@ inline constexpr char kGroundTruthMapFile[] = "ground_truth_map.csv";
 inline constexpr char kDivergenceFile[] = "divergence.csv";
 inline constexpr char kVideoFile[] = "video.mp4";
 inline constexpr char kFinalImageFile[] = "final.png";
+/// An imported log's reference trajectory (`mjslam import`): the poses the
+/// log itself carries, a SLAM estimate, not ground truth.
+inline constexpr char kReferenceFile[] = "reference.csv";
 /// Files of a sweep directory besides config.yaml, summary.json and
 /// divergence.csv: the runs' folder and the average NEES per step.
 inline constexpr char kSweepRunsFolder[] = "runs";
@@ -60,6 +63,9 @@ std::vector<std::string> MapColumns();
 /// nees.csv of a sweep: t, classical_anees, selective_anees, lower, upper,
 /// n_runs.
 std::vector<std::string> NeesColumns();
+/// reference.csv: t, x, y, th (the pose of R at each scan of an imported log
+/// that carries one).
+std::vector<std::string> ReferenceColumns();
 /// divergence.csv: num_points, pair, mean, variance (pair is text).
 std::vector<std::string> DivergenceColumns();
 

@@ -142,6 +142,7 @@ Eigen::MatrixXd EkfSlam::MahalanobisDistances(const std::vector<Observation>& ob
   const int num_observations = static_cast<int>(observations.size());
   Eigen::MatrixXd d2 = Eigen::MatrixXd::Constant(num_observations, state_.num_features(),
                                                  std::numeric_limits<double>::infinity());
+  const Pose2 X_WS = X_WR() * state_.X_RS();
   for (int k = 0; k < state_.num_features(); ++k) {
     // The prediction and H P H^T depend on the feature only: once per feature.
     const SlamState::Measurement m = state_.Measure(k);
@@ -149,6 +150,7 @@ Eigen::MatrixXd EkfSlam::MahalanobisDistances(const std::vector<Observation>& ob
     for (int i = 0; i < num_observations; ++i) {
       const Observation& observation = observations[i];
       if (observation.type != state_.feature_type(k)) continue;
+      if (observation.type == FeatureType::kLine && !SegmentsMeet(k, observation, X_WS)) continue;
       // A line's prediction in the observation's polar form.
       Eigen::Vector2d h = m.h;
       Eigen::Matrix2d HPHt = m.HPHt;
@@ -165,6 +167,15 @@ Eigen::MatrixXd EkfSlam::MahalanobisDistances(const std::vector<Observation>& ob
     }
   }
   return d2;
+}
+
+bool EkfSlam::SegmentsMeet(int k, const Observation& observation, const Pose2& X_WS) const {
+  const double max_gap = params_.line_match_max_gap_m;
+  if (max_gap <= 0.0) return true;
+  const LineSegment seen = SegmentFromPoints(state_.feature(k), X_WS * observation.p_SA,
+                                             X_WS * observation.p_SB);
+  const LineSegment& known = info_[k].segment;
+  return std::max(seen.s_min - known.s_max, known.s_min - seen.s_max) <= max_gap;
 }
 
 void EkfSlam::GrowSegment(int k, const Observation& observation) {

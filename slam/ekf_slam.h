@@ -130,6 +130,9 @@ class EkfSlam {
   std::vector<Observation> CollectObservations(const ScanFeatures& features) const;
   // The squared Mahalanobis distances, observations x features.
   Eigen::MatrixXd MahalanobisDistances(const std::vector<Observation>& observations) const;
+  // Whether line observation `observation`, seen from X_WS, passes the
+  // segment gate (EkfParams::line_match_max_gap_m) of map line k.
+  bool SegmentsMeet(int k, const Observation& observation, const Pose2& X_WS) const;
   // Extends line k's seen segment with an observation's endpoints, seen from
   // the current pose estimate.
   void GrowSegment(int k, const Observation& observation);

@@ -192,6 +192,13 @@ struct EkfParams {
   /// observation as an independent feature, as in the paper, and the map
   /// counts the scan's information twice (docs/method.md, departure 12).
   bool corners_from_map_lines = true;
+  /// Segment gate of line association, metres: a line observation may match
+  /// a map line only when its seen segment, projected on the map line,
+  /// overlaps the map line's seen segment or stops short of it by at most
+  /// this. 0 (default): no segment gate, lines are infinite as in the paper.
+  /// Real buildings have many collinear walls (both sides of a corridor's
+  /// doors, offices in a row), which the infinite line model confuses.
+  double line_match_max_gap_m = 0.0;
   /// MAX of the paper's Algorithm 2: the most features used per correction by
   /// the selective filter (>= 1). Ignored by the classical filter.
   int max_updates = 2;
@@ -219,6 +226,7 @@ struct EkfParams {
     a->Visit(MJSLAM_NVP(new_feature_probability));
     a->Visit(MJSLAM_NVP(correct_corners_of_matched_lines));
     a->Visit(MJSLAM_NVP(corners_from_map_lines));
+    a->Visit(MJSLAM_NVP(line_match_max_gap_m));
     a->Visit(MJSLAM_NVP(max_updates));
     a->Visit(MJSLAM_NVP(selection_policy));
   }

@@ -15,8 +15,8 @@ namespace {
 namespace fs = std::filesystem;
 
 // Project folders that hold code.
-const std::set<std::string> kCodeFolders = {"common", "config", "sim",     "slam", "explorer",
-                                            "eval",   "rundir", "renders", "app"};
+const std::set<std::string> kCodeFolders = {"common", "config",   "sim",     "slam", "explorer",
+                                            "eval",   "rundir",   "realdata", "renders", "app"};
 
 // What each folder may include from the project and from outside.
 struct Rule {
@@ -35,6 +35,8 @@ Rule RuleFor(const std::string& folder) {
   // The run directory's format: common and files. eval/map_types.h is the
   // map feature the map CSVs hold, until one map feature lives in common/.
   if (folder == "rundir") return {{"common", "rundir"}, false, false, false, true};
+  // Real logs: read files, know common's poses; not the run directory.
+  if (folder == "realdata") return {{"common", "realdata"}, false, false, false, true};
   if (folder == "config") return {{"common", "config"}, false, true, false, true};
   if (folder == "sim") return {{"common", "sim"}, true, false, false, true};
   if (folder == "renders") return {kCodeFolders, true, false, true, true};

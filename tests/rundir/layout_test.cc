@@ -102,6 +102,7 @@ TEST(LayoutTest, DocumentedColumnsOfTheOtherFilesAreTheWrittenOnes) {
   EXPECT_EQ(DocumentedColumns(docs, "## `scans.csv`"), ScanColumns(181));
   EXPECT_EQ(DocumentedColumns(docs, "## `explorer.csv`"), ExplorerColumns());
   EXPECT_EQ(DocumentedColumns(docs, "## Map CSVs"), MapColumns());
+  EXPECT_EQ(DocumentedColumns(docs, "## `reference.csv` (imported logs)"), ReferenceColumns());
   EXPECT_EQ(DocumentedColumns(docs, "## `divergence.csv`"), DivergenceColumns());
   EXPECT_EQ(DocumentedColumns(docs, "## `nees.csv` (sweep directory)"), NeesColumns());
 }
@@ -121,7 +122,8 @@ TEST(LayoutTest, EveryFileIsDocumented) {
   const std::string docs = ReadDocs();
   for (const std::string file :
        {kConfigFile, kManifestFile, kSummaryFile, kTrajectoryFile, kScansFile, kExplorerFile,
-        kGroundTruthMapFile, kDivergenceFile, kVideoFile, kFinalImageFile, kNeesFile}) {
+        kGroundTruthMapFile, kDivergenceFile, kVideoFile, kFinalImageFile, kNeesFile,
+        kReferenceFile}) {
     EXPECT_NE(docs.find("`" + file + "`"), std::string::npos) << file;
   }
   for (const std::string& name : FilterNames()) {

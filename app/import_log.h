@@ -1,0 +1,68 @@
+#pragma once
+
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "app/run_config.h"
+#include "realdata/carmen_log.h"
+
+namespace mjslam::app {
+
+/// Inputs of `mjslam import` (docs/real_data.md).
+struct ImportOptions {
+  /// The CARMEN log, plain or gzip.
+  std::string log_path;
+  /// The run directory to write.
+  std::string out_dir;
+  std::string config_path;
+  std::string command_line;
+  /// How to read the log (beam layout, maximum range, bad lines).
+  realdata::CarmenReadOptions read;
+  /// The laser message stream to use (FLASER, RLASER, ROBOTLASER1, ...);
+  /// empty: the first of FLASER, ROBOTLASER1, RAWLASER1 the log has.
+  std::string laser;
+  /// Distance of the laser ahead of the robot centre, metres; NaN: the log's
+  /// PARAM robot_frontlaser_offset (robot_rearlaser_offset for RLASER), or 0.
+  double laser_offset_m = std::numeric_limits<double>::quiet_NaN();
+  /// Whether the laser messages' poses are the reference trajectory: "auto"
+  /// (when they are not the odometry: more than 5 cm or 0.05 rad from it at
+  /// some scan), "yes" or "no".
+  std::string reference = "auto";
+  /// The relations file of the log (Kuemmerle et al. 2009), optional, with
+  /// the offset from its timestamps to the log's (NaN: searched with
+  /// realdata::BestTimeOffset) and the matching tolerance, seconds. Kept in
+  /// the manifest for `mjslam evaluate`.
+  std::string relations_path;
+  double time_offset_s = std::numeric_limits<double>::quiet_NaN();
+  double tolerance_s = 0.006;
+};
+
+/// What an import read and wrote, for the command's report.
+struct ImportReport {
+  std::string laser;
+  int num_beams = 0;
+  int num_scans = 0;
+  int num_odometry = 0;
+  int num_steps = 0;
+  bool has_reference = false;
+  double time_offset_s = 0.0;
+  /// realdata::SkipReport of the log, plus the scans left out by the import.
+  std::vector<std::string> skipped;
+};
+
+/// `mjslam import`: reads a CARMEN log and writes a run directory that
+/// replay, evaluate and render understand, then runs both filters on it:
+/// config.yaml (`config` with laser.num_beams, fov_deg and max_range_m of
+/// the log), manifest.json (mode "import", the source, the counts, the
+/// laser mount, the relations and matching), scans.csv (ranges at or past
+/// the maximum, or <= 0, become no-return at the maximum; no true pose),
+/// reference.csv (when the log has a reference), trajectory.csv and the
+/// maps. One step per odometry message and per scan, in time order; the
+/// odometry at a scan is interpolated between its neighbours and given for
+/// frame R (control_point_offset_m ahead of the robot centre), its frame
+/// placed so that it starts at the reference's first pose. Throws
+/// std::runtime_error naming the file and line of bad input.
+ImportReport ImportLog(RunConfig config, const ImportOptions& options);
+
+}  // namespace mjslam::app

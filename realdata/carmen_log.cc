@@ -1,0 +1,265 @@
+#include "realdata/carmen_log.h"
+
+#include <zlib.h>
+
+#include <cmath>
+#include <cstdlib>
+#include <memory>
+#include <sstream>
+#include <stdexcept>
+
+namespace mjslam::realdata {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kDegToRad = kPi / 180.0;
+// The range a SICK LMS reports without an echo (8183 cm): CARMEN's FLASER
+// maximum when the log names none.
+constexpr double kSickNoReturnM = 81.83;
+// The first malformed lines kept verbatim in CarmenLog::bad_lines.
+constexpr std::size_t kMaxBadLinesKept = 5;
+
+// A malformed line: its message, without the file and line.
+struct BadLine : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+std::vector<std::string> SplitTokens(const std::string& line) {
+  std::vector<std::string> tokens;
+  std::istringstream in(line);
+  std::string token;
+  while (in >> token) tokens.push_back(token);
+  return tokens;
+}
+
+// Reads the lines of a plain or gzip file (zlib passes plain files through).
+class LineReader {
+ public:
+  explicit LineReader(const std::string& path) : file_(gzopen(path.c_str(), "rb"), gzclose) {
+    if (!file_) throw std::runtime_error(path + ": cannot open");
+    path_ = path;
+  }
+  bool Next(std::string* line) {
+    line->clear();
+    char buffer[1 << 16];
+    while (gzgets(file_.get(), buffer, sizeof(buffer)) != nullptr) {
+      line->append(buffer);
+      if (!line->empty() && line->back() == '\n') {
+        line->pop_back();
+        if (!line->empty() && line->back() == '\r') line->pop_back();
+        return true;
+      }
+    }
+    int error = Z_OK;
+    const char* message = gzerror(file_.get(), &error);
+    if (error != Z_OK && error != Z_BUF_ERROR) {
+      throw std::runtime_error(path_ + ": cannot read: " + message);
+    }
+    return !line->empty();  // a last line without a line end
+  }
+
+ private:
+  std::unique_ptr<gzFile_s, int (*)(gzFile)> file_;
+  std::string path_;
+};
+
+// Reads the message fields of one line, each checked.
+class Fields {
+ public:
+  explicit Fields(std::vector<std::string> tokens) : tokens_(std::move(tokens)) {}
+  std::size_t size() const { return tokens_.size(); }
+  double Number(std::size_t i) const {
+    if (i >= tokens_.size()) {
+      throw BadLine(tokens_[0] + ": field " + std::to_string(i) + " missing (truncated line?)");
+    }
+    const std::string& text = tokens_[i];
+    char* end = nullptr;
+    const double value = std::strtod(text.c_str(), &end);
+    if (end == text.c_str() || *end != '\0' || !std::isfinite(value)) {
+      throw BadLine(tokens_[0] + ": field " + std::to_string(i) + ": expected a number (got '" +
+                    text + "')");
+    }
+    return value;
+  }
+  int Count(std::size_t i) const {
+    const double value = Number(i);
+    if (value < 0 || value > 100000 || value != std::floor(value)) {
+      throw BadLine(tokens_[0] + ": field " + std::to_string(i) +
+                    ": expected a count (got '" + tokens_[i] + "')");
+    }
+    return static_cast<int>(value);
+  }
+  void ExpectSize(std::size_t expected, const std::string& what) const {
+    if (tokens_.size() != expected) {
+      throw BadLine(tokens_[0] + ": expected " + std::to_string(expected) + " fields " + what +
+                    " (got " + std::to_string(tokens_.size()) + "; truncated line?)");
+    }
+  }
+  Pose2 PoseAt(std::size_t i) const { return Pose2(Number(i), Number(i + 1), Number(i + 2)); }
+  std::vector<double> Ranges(std::size_t first, int n) const {
+    std::vector<double> ranges(n);
+    for (int b = 0; b < n; ++b) ranges[b] = Number(first + b);
+    return ranges;
+  }
+  // The ipc timestamp: third field from the end (timestamp hostname logger).
+  double IpcTimestamp() const { return Number(tokens_.size() - 3); }
+
+ private:
+  std::vector<std::string> tokens_;
+};
+
+OdometryMessage ParseOdom(const Fields& f) {
+  f.ExpectSize(10, "(ODOM x y theta tv rv accel timestamp host logger_timestamp)");
+  OdometryMessage odom;
+  odom.pose = f.PoseAt(1);
+  odom.tv_mps = f.Number(4);
+  odom.rv_radps = f.Number(5);
+  odom.t_s = f.IpcTimestamp();
+  return odom;
+}
+
+// FLASER/RLASER n r_1..r_n x y theta odom_x odom_y odom_theta timestamp host logger.
+LaserMessage ParseOldLaser(const Fields& f, const CarmenReadOptions& options, double max_range_m) {
+  const int n = f.Count(1);
+  f.ExpectSize(2 + n + 9, "for " + std::to_string(n) + " beams");
+  LaserMessage laser;
+  laser.ranges_m = f.Ranges(2, n);
+  laser.angle_min_rad = options.angle_min_deg * kDegToRad;
+  laser.angle_increment_rad =
+      (options.angle_step_deg > 0.0 ? options.angle_step_deg : CarmenDefaultStepDeg(n)) *
+      kDegToRad;
+  laser.max_range_m = max_range_m;
+  laser.has_poses = true;
+  laser.laser_pose = f.PoseAt(2 + n);
+  laser.robot_pose = f.PoseAt(5 + n);
+  laser.t_s = f.IpcTimestamp();
+  return laser;
+}
+
+// RAWLASERk / ROBOTLASERk: type start_angle fov resolution max_range accuracy
+// remission_mode n r_1..r_n n_rem rem_1..rem_m, then (ROBOTLASER) laser pose,
+// robot pose, tv rv forward_safety side_safety turn_axis; timestamp host logger.
+LaserMessage ParseNewLaser(const Fields& f, bool robot, double max_range_override_m) {
+  const int n = f.Count(8);
+  const int num_remissions = f.Count(9 + n);
+  const std::size_t tail = robot ? 11 : 0;
+  f.ExpectSize(10 + n + num_remissions + tail + 3,
+               "for " + std::to_string(n) + " beams and " + std::to_string(num_remissions) +
+                   " remissions");
+  LaserMessage laser;
+  laser.angle_min_rad = f.Number(2);
+  laser.angle_increment_rad = f.Number(4);
+  laser.max_range_m = max_range_override_m > 0.0 ? max_range_override_m : f.Number(5);
+  laser.ranges_m = f.Ranges(9, n);
+  if (robot) {
+    const std::size_t poses = 10 + n + num_remissions;
+    laser.has_poses = true;
+    laser.laser_pose = f.PoseAt(poses);
+    laser.robot_pose = f.PoseAt(poses + 3);
+  }
+  laser.t_s = f.IpcTimestamp();
+  return laser;
+}
+
+bool IsNewLaser(const std::string& kind, const char* prefix) {
+  const std::string p(prefix);
+  return kind.size() == p.size() + 1 && kind.compare(0, p.size(), p) == 0 &&
+         kind.back() >= '1' && kind.back() <= '4';
+}
+
+// The maximum range of FLASER/RLASER: the user's, the log's PARAM, or SICK's.
+double OldLaserMaxRange(const CarmenLog& log, const CarmenReadOptions& options) {
+  if (options.max_range_m > 0.0) return options.max_range_m;
+  const auto it = log.params.find("robot_front_laser_max");
+  if (it != log.params.end()) {
+    char* end = nullptr;
+    const double value = std::strtod(it->second.c_str(), &end);
+    if (*end == '\0' && value > 0.0) return value;
+  }
+  return kSickNoReturnM;
+}
+
+// Keeps a message whose timestamp is positive and after the last one kept.
+template <typename Message>
+void Keep(Message message, const std::string& kind, std::vector<Message>* stream, CarmenLog* log) {
+  if (message.t_s <= 0.0) {
+    ++log->skipped[kind + ": timestamp <= 0"];
+  } else if (!stream->empty() && message.t_s <= stream->back().t_s) {
+    ++log->skipped[kind + ": timestamp not after the previous one"];
+  } else {
+    stream->push_back(std::move(message));
+  }
+}
+
+}  // namespace
+
+double CarmenDefaultStepDeg(int num_beams) {
+  if (num_beams == 180 || num_beams == 181) return 1.0;
+  if (num_beams == 360 || num_beams == 361) return 0.5;
+  if (num_beams == 720 || num_beams == 721) return 0.25;
+  return num_beams > 1 ? 180.0 / (num_beams - 1) : 180.0;
+}
+
+CarmenLog ReadCarmenLog(const std::string& path, const CarmenReadOptions& options) {
+  CarmenLog log;
+  log.path = path;
+  LineReader reader(path);
+  std::string line;
+  // The last ODOM message read, kept or not, and whether it is the message
+  // just before the current line.
+  OdometryMessage last_odom;
+  bool odom_just_before = false;
+  while (reader.Next(&line)) {
+    const int line_number = ++log.num_lines;
+    std::vector<std::string> tokens = SplitTokens(line);
+    if (tokens.empty() || tokens[0][0] == '#') continue;
+    const std::string kind = tokens[0];
+    Fields fields(std::move(tokens));
+    try {
+      if (kind == "PARAM") {
+        if (fields.size() < 3) throw BadLine("PARAM: expected a name and a value");
+        std::vector<std::string> pair = SplitTokens(line);
+        log.params[pair[1]] = pair[2];
+      } else if (kind == "ODOM") {
+        OdometryMessage odom = ParseOdom(fields);
+        odom.line = line_number;
+        Keep(odom, kind, &log.odometry, &log);
+        last_odom = odom;
+        odom_just_before = true;
+        continue;
+      } else if (kind == "FLASER" || kind == "RLASER" || IsNewLaser(kind, "RAWLASER") ||
+                 IsNewLaser(kind, "ROBOTLASER")) {
+        LaserMessage laser =
+            kind == "FLASER" || kind == "RLASER"
+                ? ParseOldLaser(fields, options, OldLaserMaxRange(log, options))
+                : ParseNewLaser(fields, kind[1] == 'O', options.max_range_m);
+        laser.kind = kind;
+        laser.line = line_number;
+        laser.has_odometry_at_scan = odom_just_before && last_odom.t_s == laser.t_s;
+        laser.odometry_at_scan = last_odom.pose;
+        Keep(laser, kind, &log.lasers[kind], &log);
+      } else {
+        ++log.skipped[kind + ": not read"];
+      }
+      odom_just_before = false;
+    } catch (const BadLine& bad) {
+      const std::string message = path + ":" + std::to_string(line_number) + ": " + bad.what();
+      if (!options.skip_bad_lines) throw std::runtime_error(message);
+      odom_just_before = false;
+      ++log.skipped["bad line"];
+      if (log.bad_lines.size() < kMaxBadLinesKept) log.bad_lines.push_back(message);
+    }
+  }
+  return log;
+}
+
+std::vector<std::string> SkipReport(const CarmenLog& log) {
+  std::vector<std::string> report;
+  for (const auto& [reason, count] : log.skipped) {
+    report.push_back(reason + ": " + std::to_string(count) + (count == 1 ? " line" : " lines"));
+  }
+  for (const std::string& bad : log.bad_lines) report.push_back("  " + bad);
+  return report;
+}
+
+}  // namespace mjslam::realdata

@@ -1,0 +1,107 @@
+#pragma once
+
+// Reader of CARMEN laser logs (the text format of the CARMEN robot toolkit,
+// one message per line; plain or gzip). docs/real_data.md describes the
+// messages read and the rules below.
+#include <map>
+#include <string>
+#include <vector>
+
+#include "common/pose2.h"
+
+namespace mjslam::realdata {
+
+/// One `ODOM` message: the wheel-odometry pose of the robot centre.
+struct OdometryMessage {
+  /// The message's ipc timestamp, seconds.
+  double t_s = 0.0;
+  /// x y theta of the robot in the odometry frame.
+  Pose2 pose;
+  /// Translational and rotational velocity the robot reported (m/s, rad/s).
+  double tv_mps = 0.0;
+  double rv_radps = 0.0;
+  /// Line of the log it came from (1-based).
+  int line = 0;
+};
+
+/// One laser message (FLASER, RLASER, ROBOTLASER1/2, RAWLASER1..4).
+struct LaserMessage {
+  /// The message name, e.g. "FLASER".
+  std::string kind;
+  /// The message's ipc timestamp, seconds.
+  double t_s = 0.0;
+  /// Ranges as logged, metres, beam 0 first (counter-clockwise).
+  std::vector<double> ranges_m;
+  /// Bearing of beam 0 and step between beams in the laser frame, radians;
+  /// the maximum range, metres. From the message (ROBOTLASER, RAWLASER), or
+  /// the rules of CarmenReadOptions (FLASER, RLASER).
+  double angle_min_rad = 0.0;
+  double angle_increment_rad = 0.0;
+  double max_range_m = 0.0;
+  /// Whether the message carries poses (FLASER, RLASER, ROBOTLASER).
+  bool has_poses = false;
+  /// The pose of the laser, and the robot's pose as the message gives it
+  /// (CARMEN's "odometry" triple of FLASER, the robot pose of ROBOTLASER).
+  Pose2 laser_pose;
+  Pose2 robot_pose;
+  /// Whether the ODOM message just before it in the log has its timestamp
+  /// (the corrected logs write the raw odometry of each scan so), and that
+  /// message's pose: the odometry at the scan, whatever the clock's jitter.
+  bool has_odometry_at_scan = false;
+  Pose2 odometry_at_scan;
+  /// Line of the log it came from (1-based).
+  int line = 0;
+};
+
+/// How to read a log: what the log itself may not say.
+struct CarmenReadOptions {
+  /// Beam layout of FLASER/RLASER, which carry only the beam count: the
+  /// bearing of beam 0, degrees (CARMEN's -90 by default), and the step
+  /// between beams, degrees (0: CarmenDefaultStepDeg of the count).
+  double angle_min_deg = -90.0;
+  double angle_step_deg = 0.0;
+  /// Maximum range, metres, for every laser message: when > 0 it replaces
+  /// the log's (ROBOTLASER/RAWLASER field, or PARAM robot_front_laser_max,
+  /// or the SICK no-return value 81.83 m).
+  double max_range_m = 0.0;
+  /// A malformed line (wrong field count, a field that is not a number) is
+  /// an error naming the line (false, the default) or a counted skip.
+  bool skip_bad_lines = false;
+};
+
+/// A whole log: the messages kept, the parameters, and what was skipped.
+struct CarmenLog {
+  /// The file read.
+  std::string path;
+  /// PARAM name -> value (text), the last one of each name.
+  std::map<std::string, std::string> params;
+  /// ODOM messages with a positive timestamp after the previous one's, in
+  /// log order.
+  std::vector<OdometryMessage> odometry;
+  /// Laser messages by kind, each with increasing timestamps.
+  std::map<std::string, std::vector<LaserMessage>> lasers;
+  /// Lines not used, by reason (e.g. "ODOM: timestamp <= 0", "NEFF: not
+  /// read", "bad line"), and the first bad lines' messages.
+  std::map<std::string, int> skipped;
+  std::vector<std::string> bad_lines;
+  /// Lines read.
+  int num_lines = 0;
+};
+
+/// The angular step CARMEN's FLASER/RLASER imply for `num_beams`, degrees:
+/// 1 for 180 or 181 beams, 0.5 for 360 or 361, 0.25 for 720 or 721, else
+/// 180 / (num_beams - 1) (a 180 deg fan, both ends included).
+double CarmenDefaultStepDeg(int num_beams);
+
+/// Reads a CARMEN log, plain or gzip (zlib reads both). Throws
+/// std::runtime_error "PATH:LINE: ..." for a malformed line (unless
+/// options.skip_bad_lines) and "PATH: ..." when the file cannot be read.
+/// Timestamps must increase within a message stream: an ODOM or laser
+/// message whose timestamp is <= 0 or not after the previous one of its kind
+/// (the corrected logs' pose lines, corrupt stamps) is skipped and counted.
+CarmenLog ReadCarmenLog(const std::string& path, const CarmenReadOptions& options = {});
+
+/// The skip counts of `log` as one line each ("NEFF: not read: 910 lines").
+std::vector<std::string> SkipReport(const CarmenLog& log);
+
+}  // namespace mjslam::realdata
