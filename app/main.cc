@@ -113,6 +113,9 @@ int RunMain(const CLI::App& run, RunCommand c, const std::string& command_line) 
   const RunResult result = RunSimulation(config, options);
   std::fprintf(stderr, "%s: %s after %d steps (%.1f s simulated)\n", options.out_dir.c_str(),
                result.status.c_str(), result.steps, result.sim_time_s);
+  for (const std::string& warning : result.warnings) {
+    std::fprintf(stderr, "%s: %s\n", options.out_dir.c_str(), warning.c_str());
+  }
   if (result.status != "completed") return 130;
   if (!c.no_evaluate) EvaluateRunDirectory(options.out_dir, EvaluateOptions{});
   if (render) {

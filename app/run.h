@@ -3,8 +3,10 @@
 #include <csignal>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "app/run_config.h"
+#include "rundir/summary.h"
 
 namespace mjslam::app {
 
@@ -35,6 +37,9 @@ struct RunResult {
   /// second of the wall time spent rendering and encoding them.
   int video_frames = 0;
   double video_fps = 0.0;
+  /// One line per filter whose innovations showed it inconsistent
+  /// (summary.json, filters.<f>.innovation_check), for the user to see.
+  std::vector<std::string> warnings;
 };
 
 /// Runs one closed-loop simulation (ClosedLoop): MuJoCo steps the robot, the
@@ -45,6 +50,11 @@ struct RunResult {
 /// the files keep every complete row so far, the manifest records the
 /// failure, and the error is rethrown.
 RunResult RunSimulation(const RunConfig& config, const RunOptions& options);
+
+/// One warning line per filter of `summary` whose innovation check found it
+/// inconsistent: the filter, the time it lost consistency with its own
+/// innovations, and the key to look at.
+std::vector<std::string> InnovationWarnings(const rundir::RunSummary& summary);
 
 /// The line `mjslam run` prints when the filters assume another range noise
 /// (slam.features.range_noise_std_m) than the simulated laser has

@@ -292,8 +292,13 @@ StepReport EkfSlam::Step(const SensorRecord& record, const ScanFeatures* feature
   report.num_observed = static_cast<int>(observations.size());
 
   // Data association against the predicted map, and the matches that correct.
-  const Association association = AssociateNearestNeighbour(
-      MahalanobisDistances(observations), gate_, new_feature_threshold_);
+  const Eigen::MatrixXd d2 = MahalanobisDistances(observations);
+  const Association association = AssociateNearestNeighbour(d2, gate_, new_feature_threshold_);
+  for (int i = 0; i < report.num_observed; ++i) {
+    if (association.outcome[i] == AssociationOutcome::kMatched) {
+      report.nis_sum += d2(i, association.feature[i]);
+    }
+  }
   std::vector<int> matched_observation;
   const std::vector<MatchedObservation> matched =
       SelectMatches(association, observations, *features, &report, &matched_observation);

@@ -51,6 +51,10 @@ struct StepReport {
   /// Observations neither matched nor added (lost a contest for a feature,
   /// or between the gate and the new-feature threshold).
   int num_ambiguous = 0;
+  /// Sum of the NIS nu^T S^-1 nu of the matched observations (num_matched of
+  /// them), each against its feature in the predicted state, before any
+  /// correction: the input of InnovationCheck.
+  double nis_sum = 0.0;
 };
 
 /// Bad data given to the filter (a non-finite record, a negative dt, an

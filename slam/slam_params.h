@@ -5,6 +5,7 @@
 
 #include "common/params.h"
 #include "slam/feature_extraction.h"
+#include "slam/innovation_check.h"
 
 namespace mjslam::slam {
 
@@ -242,20 +243,25 @@ struct SlamParams {
   /// command period skips the scans that arrive meanwhile). The string lives
   /// only here, where YAML is read; app/slam_pair.h turns it into an enum.
   std::string timing = "every_scan";
+  /// The run's check of each filter against its own innovations
+  /// (`slam.innovation_check.*`; InnovationCheck).
+  InnovationCheckParams innovation_check;
 
   template <typename Archive>
   void Serialize(Archive* a) {
     a->Visit(MJSLAM_NVP(features));
     a->Visit(MJSLAM_NVP(ekf));
     a->Visit(MJSLAM_NVP(timing));
+    a->Visit(MJSLAM_NVP(innovation_check));
   }
-  /// Problems of both parts, keys prefixed `features.` and `ekf.`, and of
-  /// `timing`.
+  /// Problems of both parts, keys prefixed `features.` and `ekf.`, of
+  /// `timing` and of `innovation_check.`.
   std::vector<ParamProblem> Validate() const {
     ParamChecker check;
     check.Merge("features", features.Validate());
     check.Merge("ekf", ekf.Validate());
     check.OneOf("timing", timing, {"every_scan", "realtime"});
+    check.Merge("innovation_check", innovation_check.Validate());
     return check.problems();
   }
   /// Throws ParamError listing every problem of Validate().
