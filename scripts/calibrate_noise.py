@@ -4,7 +4,7 @@ values of slam.ekf.command_noise.*, slam.ekf.odometry_noise.*,
 slam.ekf.lateral_skid_s and slam.ekf.lateral_slip_std_m_per_rad
 (docs/method.md, "Calibrating the process noise").
 
-    scripts/calibrate_noise.py DIR [DIR ...] [--offset A] [--json FILE]
+    scripts/calibrate_noise.py DIR [DIR ...] [--offset A] [--window L] [--json FILE]
 
 Each DIR is a run directory (with trajectory.csv) or a sweep directory (its
 runs/run_*/ are taken). For every step k of a trajectory (rows k-1 and k,
@@ -20,7 +20,12 @@ an arc along the mid-arc heading, plus a sideways skid):
       sigma_v = v_noise_std_mps + v_noise_fraction |v| + change_noise_fraction |v - v_prev|
       sigma_w = w_noise_std_radps + w_noise_fraction |w| + change_noise_fraction |w - w_prev|
   (slam/motion_model.h, CommandInput), and the five constants are fitted by
-  maximum likelihood over all steps.
+  maximum likelihood. The wheels' lag makes successive errors alike, which
+  a filter that takes them as independent underrates; --window L fits the
+  errors of the increments summed over L steps instead (their variance the
+  sum of the steps' variances, as the filter adds them), so that the noise
+  is right over L steps. The printed ratios for L = 1 .. 100 show at which
+  time scale a fit holds.
 - odometry: the increment between the odometry poses of rows k-1 and k,
   against the true one, modelled as in OdometryInput (variances linear in
   the distance rolled and the angle turned), fitted by maximum likelihood.
@@ -170,17 +175,54 @@ def command_errors(s):
     return (s["d"] / s["dt"] - s["v"], s["dth"] / s["dt"] - s["w"])
 
 
-def fit_command(steps):
-    def nll(p):
-        pairs = []
-        for s in steps:
+def windows_of(runs_steps, window):
+    """The steps cut into consecutive windows of `window` steps, per run (a
+    run's last, shorter window is dropped)."""
+    out = []
+    for steps in runs_steps:
+        for i in range(0, len(steps) - window + 1, window):
+            out.append(steps[i:i + window])
+    return out
+
+
+def window_pairs(windows, p):
+    """(error, variance) of the increments summed over each window: the true
+    distance and turn less the commanded ones, against the sum of the
+    per-step variances the filter adds (dt sigma)^2."""
+    pairs = []
+    for window in windows:
+        ed = eth = vd = vth = 0.0
+        for s in window:
             sv, sw = command_sigmas(s, p)
             ev, ew = command_errors(s)
-            pairs.append((ev, sv * sv))
-            pairs.append((ew, sw * sw))
-        return gaussian_nll(pairs)
+            ed += ev * s["dt"]
+            eth += ew * s["dt"]
+            vd += (sv * s["dt"]) ** 2
+            vth += (sw * s["dt"]) ** 2
+        pairs.append((ed, vd))
+        pairs.append((eth, vth))
+    return pairs
 
-    return fit(nll, [0.01, 0.05, 0.01, 0.05, 0.3])
+
+def fit_command(runs_steps, window):
+    """CommandNoiseParams by maximum likelihood of the increments' errors
+    summed over windows of `window` steps (1: every step on its own)."""
+    windows = windows_of(runs_steps, window)
+    return fit(lambda p: gaussian_nll(window_pairs(windows, p)), [0.01, 0.05, 0.01, 0.05, 0.3])
+
+
+def variance_ratios(runs_steps, p, lengths):
+    """For each window length: sum of the squared summed errors over the sum
+    of the model's summed variances, distance and turn (1 when the errors of
+    successive steps are independent and the model fits)."""
+    ratios = []
+    for length in lengths:
+        pairs = window_pairs(windows_of(runs_steps, length), p)
+        d = pairs[0::2]
+        th = pairs[1::2]
+        ratios.append((length, sum(e * e for e, _ in d) / sum(v for _, v in d),
+                       sum(e * e for e, _ in th) / sum(v for _, v in th)))
+    return ratios
 
 
 def odometry_variances(s, p):
@@ -234,19 +276,27 @@ def main():
     parser.add_argument("dirs", nargs="+", help="run or sweep directories")
     parser.add_argument("--offset", type=float, default=0.2,
                         help="distance from the axle centre to R, metres (default 0.2)")
+    parser.add_argument("--window", type=int, default=1,
+                        help="fit the command noise to the errors summed over windows of this "
+                             "many steps (default 1: each step on its own)")
     parser.add_argument("--json", help="also write the fitted values to this JSON file")
     args = parser.parse_args()
 
     try:
         runs = run_dirs(args.dirs)
-        steps = [s for run in runs for s in read_steps(run, args.offset)]
+        runs_steps = [read_steps(run, args.offset) for run in runs]
+        steps = [s for run_steps in runs_steps for s in run_steps]
         if len(steps) < 100:
             raise ValueError(f"only {len(steps)} steps in {len(runs)} runs: too few to fit")
         c, k = fit_skid(steps)
     except (OSError, ValueError) as e:
         print(f"calibrate_noise: {e}", file=sys.stderr)
         return 2
-    command = fit_command(steps)
+    if args.window < 1:
+        print(f"calibrate_noise: --window: expected an integer >= 1 (got {args.window})",
+              file=sys.stderr)
+        return 2
+    command = fit_command(runs_steps, args.window)
     odometry = fit_odometry(steps)
 
     print(f"# scripts/calibrate_noise.py: {len(steps)} steps from {len(runs)} runs")
@@ -265,6 +315,11 @@ def main():
     print(f"    lateral_skid_s: {c:.4g}")
     print(f"    lateral_slip_std_m_per_rad: {k:.4g}")
 
+    print(f"# command noise fitted to errors summed over {args.window} step(s)")
+    print("# summed errors over windows of L steps: mean e^2 / model variance, distance and turn")
+    print("# (1 where the fit holds at that time scale; growing with L: errors persist)")
+    for length, rd, rth in variance_ratios(runs_steps, command, [1, 2, 5, 10, 20, 50, 100]):
+        print(f"#   L = {length:3d}: {rd:6.2f} {rth:6.2f}")
     print("# fit: mean (error / sigma)^2 by bin (1 where the model fits)")
 
     def nv(s):

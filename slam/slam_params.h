@@ -177,6 +177,15 @@ struct EkfParams {
   /// (2 dof) of this probability (>= gate_probability, < 1). Observations in
   /// between are neither matched nor added. 0.9999 gives 18.4.
   double new_feature_probability = 0.9999;
+  /// Whether a line observation may match only a line feature seen from the
+  /// same side: a wall's face is visible from its front only, so with the
+  /// sensor clearly (3 sigma of the predicted rho) on the other side of the
+  /// line than when the feature was made, the observation is of another
+  /// face (the back of a thin wall, 0.15 m away) and is not compared with
+  /// it. false: any line of similar (rho, alpha) in the sensor frame may
+  /// match, and in a maze of thin walls seen from both sides, faces are
+  /// confused (docs/method.md, departure 5; docs/results.md, "The maze").
+  bool gate_line_side = true;
   /// Whether a corner whose two lines both matched map features in the same
   /// scan also corrects the state. A corner is the intersection of its two
   /// lines, fitted to the same points: correcting with all three counts that
@@ -218,6 +227,7 @@ struct EkfParams {
     a->Visit(MJSLAM_NVP(extra_corner_bearing_std_rad));
     a->Visit(MJSLAM_NVP(gate_probability));
     a->Visit(MJSLAM_NVP(new_feature_probability));
+    a->Visit(MJSLAM_NVP(gate_line_side));
     a->Visit(MJSLAM_NVP(correct_corners_of_matched_lines));
     a->Visit(MJSLAM_NVP(corners_from_map_lines));
     a->Visit(MJSLAM_NVP(max_updates));
