@@ -62,16 +62,21 @@ def run_dirs(paths):
     return runs
 
 
-def axle_increment(x0, y0, th0, x1, y1, th1, offset):
-    """(d, dth, lateral) of the axle centre between two poses of R: d the arc
-    length whose chord is the motion along the mid-arc heading, lateral the
-    motion across it (OdometryInput's inversion of the model)."""
+def axle_motion(x0, y0, th0, x1, y1, th1, offset):
+    """(chord, dth, lateral) of the axle centre (`offset` metres behind R)
+    between two poses of R: its motion along and across the mid-arc heading,
+    and the heading change."""
     dx = (x1 - offset * math.cos(th1)) - (x0 - offset * math.cos(th0))
     dy = (y1 - offset * math.sin(th1)) - (y0 - offset * math.sin(th0))
     dth = math.remainder(th1 - th0, 2.0 * math.pi)
     mid = th0 + 0.5 * dth
-    chord = dx * math.cos(mid) + dy * math.sin(mid)
-    lateral = -dx * math.sin(mid) + dy * math.cos(mid)
+    return dx * math.cos(mid) + dy * math.sin(mid), dth, -dx * math.sin(mid) + dy * math.cos(mid)
+
+
+def axle_increment(x0, y0, th0, x1, y1, th1, offset):
+    """(d, dth, lateral): axle_motion with the chord turned into the arc
+    length d whose chord it is (OdometryInput's inversion of the model)."""
+    chord, dth, lateral = axle_motion(x0, y0, th0, x1, y1, th1, offset)
     half = 0.5 * dth
     sinc = 1.0 - half * half / 6.0 if abs(half) < 1e-4 else math.sin(half) / half
     return chord / sinc, dth, lateral

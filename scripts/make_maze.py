@@ -44,6 +44,19 @@ def carve(n, loops, seed):
     return h, v
 
 
+def runs(flags):
+    """(start, end) of each run of consecutive true flags, end exclusive."""
+    out = []
+    start = None
+    for i, flag in enumerate(list(flags) + [False]):
+        if flag and start is None:
+            start = i
+        elif not flag and start is not None:
+            out.append((start, i))
+            start = None
+    return out
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     parser.add_argument("out")
@@ -58,27 +71,11 @@ def main():
     # Merge runs of wall pieces along each grid line; each box spans whole
     # cell edges plus half a thickness at both ends so that corners close.
     for j in range(n + 1):
-        i = 0
-        while i < n:
-            if not h[i][j]:
-                i += 1
-                continue
-            k = i
-            while k < n and h[k][j]:
-                k += 1
-            boxes.append(((i + k) * p / 2, j * p, (k - i) * p / 2 + t / 2, t / 2))
-            i = k
+        for a, b in runs([h[i][j] for i in range(n)]):
+            boxes.append(((a + b) * p / 2, j * p, (b - a) * p / 2 + t / 2, t / 2))
     for i in range(n + 1):
-        j = 0
-        while j < n:
-            if not v[i][j]:
-                j += 1
-                continue
-            k = j
-            while k < n and v[i][k]:
-                k += 1
-            boxes.append((i * p, (j + k) * p / 2, t / 2, (k - j) * p / 2 + t / 2))
-            j = k
+        for a, b in runs(v[i]):
+            boxes.append((i * p, (a + b) * p / 2, t / 2, (b - a) * p / 2 + t / 2))
     side = n * p
     lines = ['<mujoco model="maze">', "  <worldbody>",
              f'    <geom name="floor" type="plane" pos="{side / 2} {side / 2} 0" '

