@@ -183,8 +183,8 @@ struct EkfParams {
   /// line than when the feature was made, the observation is of another
   /// face (the back of a thin wall, 0.15 m away) and is not compared with
   /// it. false: any line of similar (rho, alpha) in the sensor frame may
-  /// match, and in a maze of thin walls seen from both sides, faces are
-  /// confused (docs/method.md, departure 5; docs/results.md, "The maze").
+  /// match, the back face too (docs/method.md, departure 5; it does not fix
+  /// the maze map loss of docs/results.md).
   bool gate_line_side = true;
   /// Whether a corner whose two lines both matched map features in the same
   /// scan also corrects the state. A corner is the intersection of its two

@@ -38,6 +38,8 @@ struct AssociationAudit {
   std::map<int, double> matched_nis;
   /// One line per wrong match or duplicate between the times asked for.
   std::vector<std::string> events;
+  /// Largest position error of the replayed filter (metres), per 50 s.
+  std::map<int, double> max_error_m;
   /// Largest |x - recorded x| of the replayed filter (0: bit-identical).
   double max_replay_difference = 0.0;
   /// Time of the last recorded step.
@@ -135,6 +137,7 @@ inline AssociationAudit AuditAssociations(const std::string& dir, const std::str
 
   AssociationAudit audit;
   std::vector<int> birth_face;  // per map feature: the true line it was made from, -1 none
+  std::vector<Eigen::Vector2d> birth_sensor;  // per map feature: the true sensor position then
   Twist2 applied;
   double previous_t = 0.0;
   char line[400];
@@ -156,6 +159,7 @@ inline AssociationAudit AuditAssociations(const std::string& dir, const std::str
     const double error = std::hypot(X_WR.x - step.X_WR_true.x, X_WR.y - step.X_WR_true.y);
     const bool shown = step.t_s >= t_from && (t_to < 0.0 || step.t_s <= t_to);
     const int bin = static_cast<int>(step.t_s / 50.0);
+    audit.max_error_m[bin] = std::max(audit.max_error_m[bin], error);
     int added = 0;
     for (int o = 0; o < report.num_observed; ++o) {
       const slam::AssociationOutcome outcome = report.association.outcome[o];
@@ -179,6 +183,8 @@ inline AssociationAudit AuditAssociations(const std::string& dir, const std::str
         const int k = features_before + added++;
         birth_face.resize(k + 1, -1);
         birth_face[k] = face;
+        birth_sensor.resize(k + 1, Eigen::Vector2d::Zero());
+        birth_sensor[k] = Eigen::Vector2d(X_WS.x, X_WS.y);
         if (face < 0) continue;
         int same = 0;
         for (int j = 0; j < k; ++j) same += birth_face[j] >= 0 && SameLine(truth[birth_face[j]], truth[face]);
@@ -197,12 +203,18 @@ inline AssociationAudit AuditAssociations(const std::string& dir, const std::str
         if (expected < 0 || SameLine(truth[expected], truth[face])) continue;
         ++audit.wrong_matches[bin];
         if (shown) {
+          // The sensor's side of the feature's true line, then and now.
+          const MapFeature& made = truth[expected];
+          const Eigen::Vector2d n(std::cos(made.params.y()), std::sin(made.params.y()));
+          const double side_then = made.params.x() - n.dot(birth_sensor[k]);
+          const double side_now = made.params.x() - n.dot(Eigen::Vector2d(X_WS.x, X_WS.y));
           std::snprintf(line, sizeof(line),
                         "t=%.1f err=%.3f WRONG match: line of true face (rho %.3f, alpha %.1f deg) "
-                        "-> feature %d made from (rho %.3f, alpha %.1f deg), NIS %.2f",
+                        "-> feature %d made from (rho %.3f, alpha %.1f deg), NIS %.2f; sensor %.2f "
+                        "from that line when it was made, %.2f now",
                         step.t_s, error, truth[face].params.x(),
-                        truth[face].params.y() * 180.0 / kPi, k, truth[expected].params.x(),
-                        truth[expected].params.y() * 180.0 / kPi, report.nearest_nis[o]);
+                        truth[face].params.y() * 180.0 / kPi, k, made.params.x(),
+                        made.params.y() * 180.0 / kPi, report.nearest_nis[o], side_then, side_now);
           audit.events.emplace_back(line);
         }
       }

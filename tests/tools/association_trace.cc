@@ -34,12 +34,13 @@ int main(int argc, char** argv) {
     std::printf("replay: largest |x - recorded %s_x| %.3g m\n", name.c_str(),
                 audit.max_replay_difference);
     std::printf("per 50 s: wrong line matches, new line features for lines already mapped; all "
-                "observations matched (mean nearest NIS), new, ambiguous\n");
+                "observations matched (mean nearest NIS), new, ambiguous; largest position "
+                "error (m)\n");
     for (int bin = 0; bin * 50.0 <= audit.end_t_s; ++bin) {
-      std::printf("  %4d-%4d s: %4d %4d; %5d (%.2f) %4d %4d\n", bin * 50, bin * 50 + 50,
+      std::printf("  %4d-%4d s: %4d %4d; %5d (%.2f) %4d %4d; %.3f\n", bin * 50, bin * 50 + 50,
                   audit.wrong_matches[bin], audit.duplicates[bin], audit.matched[bin],
                   audit.matched_nis[bin] / std::max(audit.matched[bin], 1), audit.added[bin],
-                  audit.ambiguous[bin]);
+                  audit.ambiguous[bin], audit.max_error_m[bin]);
     }
     std::printf("total: %d wrong line matches, %d duplicate line features\n",
                 audit.total_wrong_matches(), audit.total_duplicates());
