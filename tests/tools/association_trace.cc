@@ -1,4 +1,4 @@
-// Diagnostic: prints what tests/support/association_audit.h finds for one
+// Diagnostic: prints what tests/tools/association_audit.h finds for one
 // filter of a run directory: each wrong line match (an observation matched
 // to a feature made from another true line) and each new line feature for a
 // true line that already has one, between T_FROM and T_TO, then counts per
@@ -14,7 +14,7 @@
 #include <string>
 #include <vector>
 
-#include "tests/support/association_audit.h"
+#include "tests/tools/association_audit.h"
 
 int main(int argc, char** argv) {
   if (argc < 2) {

@@ -5,7 +5,7 @@
 // observation against the world's true geometry: the true wall face an
 // observed line comes from (found with the true laser pose) against the line
 // of the face whose observation created the map feature it was matched to.
-// Used by the maze regression test and by tests/tools/association_trace.cc.
+// Used by tests/tools/association_trace.cc.
 // Links mjslam::app.
 
 #include <algorithm>
