@@ -300,7 +300,13 @@ SweepRuns ReadSweepRuns(const std::vector<std::string>& run_dirs) {
     runs.times.push_back(run_times);
     for (std::size_t f = 0; f < names.size(); ++f) {
       runs.nees[f].push_back(PoseNees(table, names[f]));
-      for (const eval::PoseStepMetrics& m : PoseSteps(table, names[f])) {
+      // Only when the trajectory has the truth and the covariance.
+      const bool has_pose = std::find(table.columns.begin(), table.columns.end(), "true_x") !=
+                                table.columns.end() &&
+                            std::find(table.columns.begin(), table.columns.end(),
+                                      names[f] + "_pxx") != table.columns.end();
+      for (const eval::PoseStepMetrics& m :
+           has_pose ? PoseSteps(table, names[f]) : std::vector<eval::PoseStepMetrics>{}) {
         for (int k = 0; k < 3; ++k) runs.inside_2sigma_pooled[f][k] += m.inside_2sigma[k] ? 1 : 0;
         ++runs.inside_2sigma_pooled[f][3];
       }
@@ -418,11 +424,13 @@ nlohmann::json FilterAggregate(std::size_t f, const SweepRuns& runs, const NeesC
                           : nlohmann::json(nullptr);
   // Inside 2 sigma per component over the steps of all runs pooled.
   const std::array<long, 4>& pooled = runs.inside_2sigma_pooled[f];
-  const double pooled_steps = std::max(pooled[3], 1L);
-  j["inside_2sigma_pooled"] = {{"x", pooled[0] / pooled_steps},
-                               {"y", pooled[1] / pooled_steps},
-                               {"th", pooled[2] / pooled_steps},
-                               {"steps", pooled[3]}};
+  const double pooled_steps = static_cast<double>(pooled[3]);
+  j["inside_2sigma_pooled"] =
+      pooled[3] == 0 ? nlohmann::json(nullptr)
+                     : nlohmann::json{{"x", pooled[0] / pooled_steps},
+                                      {"y", pooled[1] / pooled_steps},
+                                      {"th", pooled[2] / pooled_steps},
+                                      {"steps", pooled[3]}};
   // The mean over runs of each run's own metrics (mjslam evaluate).
   const std::string base = "/filters/" + name;
   for (const char* key : {"mean_nees"}) {
