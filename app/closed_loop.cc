@@ -285,6 +285,12 @@ rundir::RunSummary ClosedLoop::Summary(bool interrupted) const {
     filter.open_loop_s = slam_->open_loop_s(f);
     filter.scans_processed = slam_->scans_processed(f);
     filter.scans_skipped = slam_->scans_skipped(f);
+    const slam::InnovationCheckResult check = slam_->innovation_check(f);
+    filter.innovation_windows = check.windows;
+    filter.innovation_failed_windows = check.failed_windows;
+    filter.innovation_longest_failed_streak = check.longest_failed_streak;
+    filter.innovation_mean_nis = check.mean_nis;
+    filter.innovation_inconsistent_since_s = check.inconsistent_since_s;
     summary.filters.push_back(filter);
   }
   return summary;

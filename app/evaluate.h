@@ -45,6 +45,12 @@ struct RunEvaluation {
 /// cannot be loaded.
 eval::Map RunGroundTruth(const std::string& run_dir, const eval::GroundTruthParams& params = {});
 
+/// The pose metrics (error, NEES, inside 2 sigma) of filter `name` at every
+/// row of a trajectory.csv table, from its estimate, covariance and truth
+/// columns.
+std::vector<eval::PoseStepMetrics> PoseSteps(const rundir::CsvTable& trajectory,
+                                             const std::string& name);
+
 /// The pose NEES (3 dof) of filter `name` at every row of a trajectory.csv
 /// table: its `<name>_nees` column when present, else computed from the
 /// estimate, the truth and the covariance columns (NaN where the covariance

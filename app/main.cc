@@ -124,6 +124,9 @@ int RunMain(const CLI::App& run, RunCommand c, const std::string& command_line) 
   const RunResult result = RunSimulation(config, options);
   std::fprintf(stderr, "%s: %s after %d steps (%.1f s simulated)\n", options.out_dir.c_str(),
                result.status.c_str(), result.steps, result.sim_time_s);
+  for (const std::string& warning : result.warnings) {
+    std::fprintf(stderr, "%s: %s\n", options.out_dir.c_str(), warning.c_str());
+  }
   if (c.profile && result.sim_time_s > 0.0) {
     std::printf("%s", PhaseCpuReport(result.cpu, result.sim_time_s, ProcessCpuSeconds()).c_str());
   }

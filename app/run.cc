@@ -1,6 +1,7 @@
 #include "app/run.h"
 
 #include <algorithm>
+#include <cstdio>
 #include <exception>
 #include <optional>
 #include <utility>
@@ -148,7 +149,9 @@ RunResult RunSimulation(const RunConfig& config, const RunOptions& options) {
     WriteMaps(loop.slam(), dir);
     // A fresh summary for this run (one from a run before is replaced);
     // evaluation merges its own keys into it.
-    rundir::WriteSummary(dir, rundir::ToJson(loop.Summary(result.status == "interrupted")));
+    const rundir::RunSummary summary = loop.Summary(result.status == "interrupted");
+    rundir::WriteSummary(dir, rundir::ToJson(summary));
+    result.warnings = InnovationWarnings(summary);
     const PhaseCpu& loop_cpu = loop.cpu();
     result.cpu.physics_s = loop_cpu.physics_s;
     result.cpu.laser_s = loop_cpu.laser_s;
@@ -165,6 +168,22 @@ RunResult RunSimulation(const RunConfig& config, const RunOptions& options) {
   manifest.Finish(result.status);
   result.cpu.run_total_s = ThreadCpuSeconds() - start_cpu_s;
   return result;
+}
+
+std::vector<std::string> InnovationWarnings(const rundir::RunSummary& summary) {
+  std::vector<std::string> lines;
+  for (const rundir::RunSummary::Filter& f : summary.filters) {
+    if (!f.innovation_inconsistent_since_s) continue;
+    char line[320];
+    std::snprintf(line, sizeof(line),
+                  "warning: the %s filter is inconsistent with its own innovations from t = %.1f s "
+                  "(%d of %d windows failed, mean NIS %.2f; summary.json "
+                  "filters.%s.innovation_check): its map and pose may be wrong",
+                  f.name.c_str(), *f.innovation_inconsistent_since_s, f.innovation_failed_windows,
+                  f.innovation_windows, f.innovation_mean_nis, f.name.c_str());
+    lines.emplace_back(line);
+  }
+  return lines;
 }
 
 }  // namespace mjslam::app

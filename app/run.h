@@ -3,9 +3,11 @@
 #include <csignal>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "app/cpu_profile.h"
 #include "app/run_config.h"
+#include "rundir/summary.h"
 
 namespace mjslam::app {
 
@@ -38,6 +40,9 @@ struct RunResult {
   double video_fps = 0.0;
   /// CPU seconds by phase of the run (PhaseCpu; `mjslam run --profile`).
   PhaseCpu cpu;
+  /// One line per filter whose innovations showed it inconsistent
+  /// (summary.json, filters.<f>.innovation_check), for the user to see.
+  std::vector<std::string> warnings;
 };
 
 /// Runs one closed-loop simulation (ClosedLoop): MuJoCo steps the robot, the
@@ -48,6 +53,11 @@ struct RunResult {
 /// the files keep every complete row so far, the manifest records the
 /// failure, and the error is rethrown.
 RunResult RunSimulation(const RunConfig& config, const RunOptions& options);
+
+/// One warning line per filter of `summary` whose innovation check found it
+/// inconsistent: the filter, the time it lost consistency with its own
+/// innovations, and the key to look at.
+std::vector<std::string> InnovationWarnings(const rundir::RunSummary& summary);
 
 /// The line `mjslam run` prints when the filters assume another range noise
 /// (slam.features.range_noise_std_m) than the simulated laser has

@@ -33,14 +33,20 @@ SlamPair::SlamPair(const slam::SlamParams& params, const ControlParams& control,
       control_(control),
       dt_s_(dt_s),
       timing_(FilterTimingFromText(params.timing)) {
+  const slam::InnovationCheck check(params.innovation_check,
+                                    slam::ChiSquare2Quantile(params.ekf.gate_probability));
   filters_.emplace_back(
-      "classical", slam::EkfSlam(params.ekf, slam::CorrectionMode::kClassical, X_WR0, X_RS,
-                                 run_rng.Fork("slam.classical.selection")));
+      "classical",
+      slam::EkfSlam(params.ekf, slam::CorrectionMode::kClassical, X_WR0, X_RS,
+                    run_rng.Fork("slam.classical.selection")),
+      check);
   // The selective filter's draws (slam.ekf.selection_policy: random) are a
   // stream of their own, forked from the run seed by name.
   filters_.emplace_back(
-      "selective", slam::EkfSlam(params.ekf, slam::CorrectionMode::kSelective, X_WR0, X_RS,
-                                 run_rng.Fork("slam.selective.selection")));
+      "selective",
+      slam::EkfSlam(params.ekf, slam::CorrectionMode::kSelective, X_WR0, X_RS,
+                    run_rng.Fork("slam.selective.selection")),
+      check);
 }
 
 void SlamPair::Step(const SensorRecord& record) {
@@ -72,6 +78,7 @@ void SlamPair::Step(const SensorRecord& record) {
       f.next_free_step = step + f.period_steps;
       f.last_processed_t_s = record.t_s;
       if (record.has_scan) ++f.scans_processed;
+      f.innovation_check.Add(record.t_s, f.report.nis_sum, f.report.num_matched);
     } else {
       // Busy: the scan is lost; with command input the record's command
       // waits for the next prediction.

@@ -10,6 +10,7 @@
 #include "eval/map_types.h"
 #include "rundir/rows.h"
 #include "slam/ekf_slam.h"
+#include "slam/innovation_check.h"
 #include "slam/slam_params.h"
 
 namespace mjslam::app {
@@ -81,6 +82,11 @@ class SlamPair {
   bool processed(int i) const { return filters_[i].processed; }
   int scans_processed(int i) const { return filters_[i].scans_processed; }
   int scans_skipped(int i) const { return filters_[i].scans_skipped; }
+  /// What the check of filter `i` against its own innovations found so far
+  /// (slam.innovation_check; slam::InnovationCheck).
+  slam::InnovationCheckResult innovation_check(int i) const {
+    return filters_[i].innovation_check.result();
+  }
   /// The timing the pair runs with.
   FilterTiming timing() const { return timing_; }
   /// Filter `i` by index, and its name.
@@ -92,10 +98,11 @@ class SlamPair {
 
  private:
   struct Filter {
-    Filter(std::string name_in, slam::EkfSlam filter_in)
-        : name(std::move(name_in)), filter(std::move(filter_in)) {}
+    Filter(std::string name_in, slam::EkfSlam filter_in, slam::InnovationCheck check_in)
+        : name(std::move(name_in)), filter(std::move(filter_in)), innovation_check(check_in) {}
     std::string name;
     slam::EkfSlam filter;
+    slam::InnovationCheck innovation_check;
     slam::StepReport report;
     double processing_us = 0.0;
     double processing_s = 0.0;

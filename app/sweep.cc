@@ -1,6 +1,7 @@
 #include "app/sweep.h"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <deque>
@@ -363,6 +364,9 @@ struct SweepRuns {
   std::vector<std::vector<double>> processing_s;
   std::vector<std::vector<double>> open_loop_s;
   std::vector<std::vector<double>> max_period_s;
+  // Per filter, pooled over every step of every run: steps inside 2 sigma
+  // for x, y, th, and the number of steps.
+  std::vector<std::array<long, 4>> inside_2sigma_pooled;
   std::vector<nlohmann::json> summaries;
 };
 
@@ -373,6 +377,7 @@ SweepRuns ReadSweepRuns(const std::vector<std::string>& run_dirs) {
   runs.processing_s.resize(names.size());
   runs.open_loop_s.resize(names.size());
   runs.max_period_s.resize(names.size());
+  runs.inside_2sigma_pooled.assign(names.size(), {0, 0, 0, 0});
   for (const std::string& run_dir : run_dirs) {
     const CsvTable table = rundir::ReadCsv(PathIn(run_dir, rundir::kTrajectoryFile));
     const int t = table.ColumnIndex("t");
@@ -381,6 +386,16 @@ SweepRuns ReadSweepRuns(const std::vector<std::string>& run_dirs) {
     runs.times.push_back(run_times);
     for (std::size_t f = 0; f < names.size(); ++f) {
       runs.nees[f].push_back(PoseNees(table, names[f]));
+      // Only when the trajectory has the truth and the covariance.
+      const bool has_pose = std::find(table.columns.begin(), table.columns.end(), "true_x") !=
+                                table.columns.end() &&
+                            std::find(table.columns.begin(), table.columns.end(),
+                                      names[f] + "_pxx") != table.columns.end();
+      for (const eval::PoseStepMetrics& m :
+           has_pose ? PoseSteps(table, names[f]) : std::vector<eval::PoseStepMetrics>{}) {
+        for (int k = 0; k < 3; ++k) runs.inside_2sigma_pooled[f][k] += m.inside_2sigma[k] ? 1 : 0;
+        ++runs.inside_2sigma_pooled[f][3];
+      }
       const int us = table.ColumnIndex(names[f] + "_us");
       double total_us = 0.0;
       for (const std::vector<double>& row : table.rows) total_us += row[us];
@@ -493,6 +508,15 @@ nlohmann::json FilterAggregate(std::size_t f, const SweepRuns& runs, const NeesC
   j["max_period_s"] = max_period_s.size() == num_runs && num_runs > 0
                           ? nlohmann::json(*std::max_element(max_period_s.begin(), max_period_s.end()))
                           : nlohmann::json(nullptr);
+  // Inside 2 sigma per component over the steps of all runs pooled.
+  const std::array<long, 4>& pooled = runs.inside_2sigma_pooled[f];
+  const double pooled_steps = static_cast<double>(pooled[3]);
+  j["inside_2sigma_pooled"] =
+      pooled[3] == 0 ? nlohmann::json(nullptr)
+                     : nlohmann::json{{"x", pooled[0] / pooled_steps},
+                                      {"y", pooled[1] / pooled_steps},
+                                      {"th", pooled[2] / pooled_steps},
+                                      {"steps", pooled[3]}};
   // The mean over runs of each run's own metrics (mjslam evaluate).
   const std::string base = "/filters/" + name;
   for (const char* key : {"mean_nees"}) {

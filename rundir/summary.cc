@@ -1,5 +1,6 @@
 #include "rundir/summary.h"
 
+#include <cmath>
 #include <stdexcept>
 
 #include "rundir/layout.h"
@@ -31,7 +32,15 @@ nlohmann::json ToJson(const RunSummary& summary) {
         {"processing_s", f.processing_s},
         {"open_loop_s", f.open_loop_s},
         {"scans_processed", f.scans_processed},
-        {"scans_skipped", f.scans_skipped}};
+        {"scans_skipped", f.scans_skipped},
+        {"innovation_check",
+         {{"verdict", f.innovation_inconsistent_since_s ? "inconsistent" : "consistent"},
+          {"inconsistent_since_s", time_or_null(f.innovation_inconsistent_since_s)},
+          {"windows", f.innovation_windows},
+          {"failed_windows", f.innovation_failed_windows},
+          {"longest_failed_streak", f.innovation_longest_failed_streak},
+          {"mean_nis", std::isfinite(f.innovation_mean_nis) ? nlohmann::json(f.innovation_mean_nis)
+                                                            : nlohmann::json(nullptr)}}}};
   }
   return json;
 }

@@ -47,6 +47,15 @@ struct RunSummary {
     /// (realtime timing; 0 with every_scan).
     int scans_processed = 0;
     int scans_skipped = 0;
+    /// The check against its own innovations (slam::InnovationCheck):
+    /// windows judged and failed, the longest failing streak, the mean NIS
+    /// of the matched observations over the run (NaN: none), and the start
+    /// of the first sustained failure (none: consistent).
+    int innovation_windows = 0;
+    int innovation_failed_windows = 0;
+    int innovation_longest_failed_streak = 0;
+    double innovation_mean_nis = 0.0;
+    std::optional<double> innovation_inconsistent_since_s;
   };
   std::vector<Filter> filters;
 };

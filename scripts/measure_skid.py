@@ -18,6 +18,9 @@ import math
 import os
 import sys
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from calibrate_noise import axle_motion  # noqa: E402
+
 
 def steps(path, offset):
     """(fwd, lat, dth, dt) of the axle centre for each step of a trajectory."""
@@ -27,14 +30,9 @@ def steps(path, offset):
         dt = float(r1["t"]) - float(r0["t"])
         if dt <= 0.0:
             continue
-        x0, y0, th0 = (float(r0[k]) for k in ("true_x", "true_y", "true_th"))
-        x1, y1, th1 = (float(r1[k]) for k in ("true_x", "true_y", "true_th"))
-        dx = (x1 - offset * math.cos(th1)) - (x0 - offset * math.cos(th0))
-        dy = (y1 - offset * math.sin(th1)) - (y0 - offset * math.sin(th0))
-        dth = math.remainder(th1 - th0, 2.0 * math.pi)
-        mid = th0 + 0.5 * dth
-        fwd = dx * math.cos(mid) + dy * math.sin(mid)
-        lat = -dx * math.sin(mid) + dy * math.cos(mid)
+        pose0 = [float(r0[k]) for k in ("true_x", "true_y", "true_th")]
+        pose1 = [float(r1[k]) for k in ("true_x", "true_y", "true_th")]
+        fwd, dth, lat = axle_motion(*pose0, *pose1, offset)
         yield fwd, lat, dth, dt
 
 

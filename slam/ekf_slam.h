@@ -51,6 +51,16 @@ struct StepReport {
   /// Observations neither matched nor added (lost a contest for a feature,
   /// or between the gate and the new-feature threshold).
   int num_ambiguous = 0;
+  /// Sum of the NIS nu^T S^-1 nu of the matched observations (num_matched of
+  /// them), each against its feature in the predicted state, before any
+  /// correction: the input of InnovationCheck.
+  double nis_sum = 0.0;
+  /// What became of each observation (lines first, then corners, as the
+  /// features were extracted), for diagnostics: its outcome and matched
+  /// feature, and `nearest_nis`, the smallest NIS to any map feature of its
+  /// type before the correction (+inf: none).
+  Association association;
+  std::vector<double> nearest_nis;
 };
 
 /// Bad data given to the filter (a non-finite record, a negative dt, an
@@ -124,7 +134,14 @@ class EkfSlam {
   struct FeatureInfo {
     int id;
     LineSegment segment;
+    // Lines: the side of the line (in its state form (r, al)) the sensor saw
+    // it from, the sign of r - p_WS . (cos al, sin al); 0 for corners.
+    int seen_side = 0;
   };
+
+  // The signed distance r - p_WS . (cos al, sin al) of the sensor from line
+  // feature k, in the line's state form, at the current estimate.
+  double SensorSideOfLine(int k) const;
 
   // Observations of `features` with their checked, inflated covariances.
   std::vector<Observation> CollectObservations(const ScanFeatures& features) const;

@@ -5,6 +5,7 @@
 
 #include "common/params.h"
 #include "slam/feature_extraction.h"
+#include "slam/innovation_check.h"
 
 namespace mjslam::slam {
 
@@ -176,6 +177,15 @@ struct EkfParams {
   /// (2 dof) of this probability (>= gate_probability, < 1). Observations in
   /// between are neither matched nor added. 0.9999 gives 18.4.
   double new_feature_probability = 0.9999;
+  /// Whether a line observation may match only a line feature seen from the
+  /// same side: a wall's face is visible from its front only, so with the
+  /// sensor clearly (3 sigma of the predicted rho) on the other side of the
+  /// line than when the feature was made, the observation is of another
+  /// face (the back of a thin wall, 0.15 m away) and is not compared with
+  /// it. false: any line of similar (rho, alpha) in the sensor frame may
+  /// match, the back face too (docs/method.md, departure 5; it does not fix
+  /// the maze map loss of docs/results.md).
+  bool gate_line_side = true;
   /// Whether a corner whose two lines both matched map features in the same
   /// scan also corrects the state. A corner is the intersection of its two
   /// lines, fitted to the same points: correcting with all three counts that
@@ -224,6 +234,7 @@ struct EkfParams {
     a->Visit(MJSLAM_NVP(extra_corner_bearing_std_rad));
     a->Visit(MJSLAM_NVP(gate_probability));
     a->Visit(MJSLAM_NVP(new_feature_probability));
+    a->Visit(MJSLAM_NVP(gate_line_side));
     a->Visit(MJSLAM_NVP(correct_corners_of_matched_lines));
     a->Visit(MJSLAM_NVP(corners_from_map_lines));
     a->Visit(MJSLAM_NVP(line_match_max_gap_m));
@@ -250,20 +261,25 @@ struct SlamParams {
   /// command period skips the scans that arrive meanwhile). The string lives
   /// only here, where YAML is read; app/slam_pair.h turns it into an enum.
   std::string timing = "every_scan";
+  /// The run's check of each filter against its own innovations
+  /// (`slam.innovation_check.*`; InnovationCheck).
+  InnovationCheckParams innovation_check;
 
   template <typename Archive>
   void Serialize(Archive* a) {
     a->Visit(MJSLAM_NVP(features));
     a->Visit(MJSLAM_NVP(ekf));
     a->Visit(MJSLAM_NVP(timing));
+    a->Visit(MJSLAM_NVP(innovation_check));
   }
-  /// Problems of both parts, keys prefixed `features.` and `ekf.`, and of
-  /// `timing`.
+  /// Problems of both parts, keys prefixed `features.` and `ekf.`, of
+  /// `timing` and of `innovation_check.`.
   std::vector<ParamProblem> Validate() const {
     ParamChecker check;
     check.Merge("features", features.Validate());
     check.Merge("ekf", ekf.Validate());
     check.OneOf("timing", timing, {"every_scan", "realtime"});
+    check.Merge("innovation_check", innovation_check.Validate());
     return check.problems();
   }
   /// Throws ParamError listing every problem of Validate().

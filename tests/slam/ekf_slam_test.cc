@@ -425,6 +425,44 @@ TEST(EkfSlamTest, GatesByMahalanobisDistanceWithADuplicateGuard) {
   EXPECT_EQ(filter.Step(Still(), &second).num_matched, 0);
 }
 
+TEST(EkfSlamTest, LineSeenFromTheOtherSideIsAnotherFace) {
+  // The wall x = 2 is seen from the origin; the robot then drives to
+  // x = 4.3 with 0.1 m of uncertainty, and sees the wall's back face, the
+  // line x = 2.15, behind it: 0.15 m from the feature's prediction, inside
+  // the gate (d2 about 2.2). It is another face of the wall: with
+  // gate_line_side (the default) it becomes a new feature; without, it is
+  // matched to the front face and pulls the pose 0.15 m off.
+  for (const bool gate_line_side : {true, false}) {
+    EkfParams params;
+    params.gate_line_side = gate_line_side;
+    params.command_noise.v_noise_std_mps = 0.1;
+    params.command_noise.v_noise_fraction = 0.0;
+    params.command_noise.change_noise_fraction = 0.0;
+    EkfSlam filter(params, CorrectionMode::kClassical, Pose2(), Pose2());
+    ScanFeatures first;
+    first.lines.push_back(WallAtTwo(0.0));
+    filter.Step(Still(), &first);
+    SensorRecord drive;
+    drive.dt_s = 1.0;
+    drive.command.v_mps = 4.3;
+    ScanFeatures back;
+    back.lines.push_back(Line(2.15, kPi, Eigen::Vector2d(-2.15, 1.0), Eigen::Vector2d(-2.15, -1.0)));
+    const StepReport report = filter.Step(drive, &back);
+    EXPECT_EQ(report.num_matched, gate_line_side ? 0 : 1) << gate_line_side;
+    EXPECT_EQ(report.num_new, gate_line_side ? 1 : 0) << gate_line_side;
+    EXPECT_EQ(filter.num_features(), gate_line_side ? 2 : 1) << gate_line_side;
+    // From the same side as before, the front face still matches.
+    if (gate_line_side) {
+      ScanFeatures front;
+      front.lines.push_back(WallAtTwo(0.0));
+      SensorRecord back_home;
+      back_home.dt_s = 1.0;
+      back_home.command.v_mps = -4.3;
+      EXPECT_EQ(filter.Step(back_home, &front).num_matched, 1);
+    }
+  }
+}
+
 TEST(EkfSlamTest, MatchesOnlyFeaturesOfTheSameType) {
   // A corner observation with the very numbers of the line's prediction.
   EkfSlam filter(EkfParams(), CorrectionMode::kClassical, Pose2(), Pose2());
