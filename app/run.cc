@@ -10,6 +10,7 @@
 #include "app/progress.h"
 #include "app/slam_pair.h"
 #include "app/version.h"
+#include "common/interrupt.h"
 #include "common/params.h"
 #include "config/config.h"
 #include "rundir/csv_writer.h"
@@ -102,6 +103,8 @@ RunResult RunSimulation(const RunConfig& config, const RunOptions& options) {
   // The manifest reads (hashes) the world and robot files: a missing one is
   // an error before anything is written.
   nlohmann::json start_manifest = StartManifest(config, options);
+  // A video of too many frames is refused before the run, not hours into it.
+  if (options.render_video) config.render.NumVideoFrames(config.run.duration_s);
   const rundir::RunDirectoryLock lock(dir);
   rundir::WriteFileAtomically(rundir::PathIn(dir, rundir::kConfigFile), config::ToYaml(config));
   rundir::ManifestWriter manifest(dir, std::move(start_manifest));
@@ -144,6 +147,11 @@ RunResult RunSimulation(const RunConfig& config, const RunOptions& options) {
     // A fresh summary for this run (one from a run before is replaced);
     // evaluation merges its own keys into it.
     rundir::WriteSummary(dir, rundir::ToJson(loop.Summary(result.status == "interrupted")));
+  } catch (const Interrupted&) {
+    // Stopped before the loop (a large world's setup): nothing to resume from.
+    record_progress();
+    manifest.Finish("interrupted");
+    throw;
   } catch (const std::exception& error) {
     record_progress();
     manifest.Fail(error.what());

@@ -151,7 +151,13 @@ std::deque<Job> PlanJobs(const std::vector<std::string>& run_dirs, const SweepOp
       if (!evaluated && options.evaluate_runs) pending.push_back({i, run_dir, Stage::kEvaluate});
       continue;
     }
-    fs::remove_all(run_dir);
+    // A run still alive from an earlier sweep (one killed so hard that its
+    // runs outlived it) holds its folder: refuse rather than delete its files
+    // and start a second writer beside it.
+    if (fs::exists(run_dir)) {
+      const rundir::RunDirectoryLock held(run_dir);
+      fs::remove_all(run_dir);
+    }
     fs::remove(run_dir + ".log");
     pending.push_back({i, run_dir, Stage::kRun});
   }

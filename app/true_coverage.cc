@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "common/check.h"
+#include "common/interrupt.h"
 
 namespace mjslam::app {
 namespace {
@@ -38,6 +39,7 @@ TrueCoverage::TrueCoverage(const std::vector<sim::ObstacleFootprint>& obstacles,
   // Clearance of every cell centre.
   Grid2<double> clearance(limits_);
   for (int j = 0; j < height; ++j) {
+    ThrowIfInterrupted("world setup (coverage grid)");
     for (int i = 0; i < width; ++i) {
       clearance(i, j) = sim::DistanceToObstacles(limits_.CellCenter(i, j), obstacles);
     }

@@ -78,6 +78,27 @@ void AddExplorerRows(const ExplorerSnapshot& snapshot, CsvWriter* explorer) {
   }
 }
 
+CsvTable ReadTrajectoryCsv(const std::string& path) {
+  CsvTable table = ReadCsv(path);
+  if (table.rows.empty()) throw std::runtime_error(path + ": no rows");
+  const std::vector<std::string> expected = RecordedTrajectoryColumns();
+  CheckLeadingColumns(table, expected);
+  CheckIncreasingTimes(table, 0);
+  const int count = static_cast<int>(expected.size()) - 1;
+  CheckValuesInRange(table, 1, count, -kMaxRecordedCoordinateM, kMaxRecordedCoordinateM);
+  return table;
+}
+
+CsvTable ReadScansCsv(const std::string& path) {
+  CsvTable table = ReadCsv(path);
+  CheckLeadingColumns(table, {"t", "x", "y", "th"});
+  CheckIncreasingTimes(table, 0);
+  CheckValuesInRange(table, 1, 3, -kMaxRecordedCoordinateM, kMaxRecordedCoordinateM);
+  const int num_ranges = static_cast<int>(table.columns.size()) - kScanRangesStart;
+  CheckValuesInRange(table, kScanRangesStart, num_ranges, 0.0, kMaxRecordedCoordinateM);
+  return table;
+}
+
 std::vector<ExplorerSnapshot> ReadExplorerCsv(const std::string& path) {
   std::vector<ExplorerSnapshot> snapshots;
   if (!std::filesystem::exists(path)) return snapshots;
