@@ -106,10 +106,10 @@ void RunReportScript(const std::vector<std::string>& arguments) {
 bool IsSweepDirectory(const std::string& dir) {
   const fs::path runs = fs::path(dir) / rundir::kSweepRunsFolder;
   if (!fs::is_directory(runs) || fs::exists(fs::path(dir) / rundir::kTrajectoryFile)) return false;
-  // At least one run of a sweep (run_000, ...): an empty runs/ is no sweep.
+  // At least one run folder of a sweep: an empty runs/ is no sweep.
   std::error_code error;
   for (const fs::directory_entry& entry : fs::directory_iterator(runs, error)) {
-    if (entry.is_directory() && entry.path().filename().string().rfind("run_", 0) == 0) return true;
+    if (entry.is_directory()) return true;
   }
   return false;
 }

@@ -44,7 +44,7 @@ RenderResult RenderRun(const std::string& run_dir, const renders::RenderParams& 
 void RenderSweep(const std::string& sweep_dir);
 
 /// True when `dir` looks like a sweep directory: no trajectory.csv, and a
-/// runs/ folder holding at least one run folder (run_000, ...).
+/// runs/ folder holding at least one folder (a sweep's runs: run_000, ...).
 bool IsSweepDirectory(const std::string& dir);
 
 }  // namespace mjslam::app

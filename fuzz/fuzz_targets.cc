@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <optional>
 #include <stdexcept>
 
 #include "app/run_config.h"
@@ -23,6 +24,19 @@ void WriteScratch(std::string_view input, const std::string& path) {
   std::ofstream out(path, std::ios::binary | std::ios::trunc);
   out.write(input.data(), static_cast<std::streamsize>(input.size()));
   if (!out) throw std::logic_error(path + ": cannot write the fuzz input");
+}
+
+// What `read` makes of `input` (written to `scratch_path`), or none when it
+// refused it with its documented error.
+template <typename Reader>
+auto ReadOrRefused(std::string_view input, const std::string& scratch_path, Reader read)
+    -> std::optional<decltype(read(scratch_path))> {
+  WriteScratch(input, scratch_path);
+  try {
+    return read(scratch_path);
+  } catch (const std::runtime_error&) {
+    return std::nullopt;  // refused, with a message
+  }
 }
 
 void ReadConfig(std::string_view input, const std::string& /*scratch_path*/) {
@@ -53,26 +67,18 @@ void ExpectIncreasingTimes(const rundir::CsvTable& table) {
 }
 
 void ReadTrajectory(std::string_view input, const std::string& scratch_path) {
-  WriteScratch(input, scratch_path);
-  rundir::CsvTable table;
-  try {
-    table = rundir::ReadTrajectoryCsv(scratch_path);
-  } catch (const std::runtime_error&) {
-    return;
-  }
+  const auto read = ReadOrRefused(input, scratch_path, rundir::ReadTrajectoryCsv);
+  if (!read) return;
+  const rundir::CsvTable& table = *read;
   Expect(!table.rows.empty(), "no rows");
   ExpectIncreasingTimes(table);
   ExpectFinite(table, 1, static_cast<int>(rundir::RecordedTrajectoryColumns().size()) - 1);
 }
 
 void ReadScans(std::string_view input, const std::string& scratch_path) {
-  WriteScratch(input, scratch_path);
-  rundir::CsvTable table;
-  try {
-    table = rundir::ReadScansCsv(scratch_path);
-  } catch (const std::runtime_error&) {
-    return;
-  }
+  const auto read = ReadOrRefused(input, scratch_path, rundir::ReadScansCsv);
+  if (!read) return;
+  const rundir::CsvTable& table = *read;
   ExpectIncreasingTimes(table);
   ExpectFinite(table, 1, static_cast<int>(table.columns.size()) - 1);
   for (const std::vector<double>& row : table.rows) {
@@ -83,25 +89,16 @@ void ReadScans(std::string_view input, const std::string& scratch_path) {
 }
 
 void ReadMap(std::string_view input, const std::string& scratch_path) {
-  WriteScratch(input, scratch_path);
-  FeatureMap map;
-  try {
-    map = rundir::ReadMapCsv(scratch_path);
-  } catch (const std::runtime_error&) {
-    return;
-  }
-  for (const MapFeature& f : map) {
+  const auto map = ReadOrRefused(input, scratch_path, rundir::ReadMapCsv);
+  if (!map) return;
+  for (const MapFeature& f : *map) {
     Expect(f.params.allFinite() && f.covariance.allFinite(), "a feature not finite");
     Expect(f.covariance(0, 0) >= 0.0 && f.covariance(1, 1) >= 0.0, "a negative variance");
   }
 }
 
 void ReadExplorer(std::string_view input, const std::string& scratch_path) {
-  WriteScratch(input, scratch_path);
-  try {
-    rundir::ReadExplorerCsv(scratch_path);
-  } catch (const std::runtime_error&) {
-  }
+  ReadOrRefused(input, scratch_path, rundir::ReadExplorerCsv);
 }
 
 }  // namespace

@@ -3,8 +3,8 @@
 # check: builds the unit tests of the readers, numerics and renderer, and the
 # program, in build-asan/ (-O1, MJSLAM_SANITIZE=ON; ccache when installed),
 # then runs those tests and a short run, replay, evaluate and render under the
-# sanitizers. Any report fails (halt_on_error, no recovery). The test suite
-# runs it as the ctest test `sanitizers` (labels sanitizers, slow).
+# sanitizers. Any report fails (halt_on_error, no recovery). Run by hand
+# (docs/reliability.md#sanitizers).
 # Usage: scripts/sanitize.sh [BUILD_DIR]   (default build-asan)
 set -euo pipefail
 cd "$(dirname "$0")/.."
