@@ -6,11 +6,13 @@
 #include <stdexcept>
 
 #include "app/run_config.h"
+#include "common/interrupt.h"
 #include "common/rng.h"
 #include "rundir/csv_writer.h"
 #include "rundir/layout.h"
 #include "rundir/manifest.h"
 #include "rundir/map_csv.h"
+#include "rundir/rows.h"
 #include "rundir/run_files.h"
 #include "rundir/summary.h"
 #include "sim/obstacles.h"
@@ -29,6 +31,23 @@ nlohmann::json Xyz(const Eigen::Vector3d& v) {
 // NaN as JSON null (nlohmann writes NaN as null anyway; explicit for clarity).
 nlohmann::json Number(double value) {
   return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(nullptr);
+}
+
+// eval::DivergenceStudy of a run's maps; its errors (a map with nothing to
+// compare) name the run's map files and its world.
+std::vector<eval::DivergenceStatistics> StudyRunMaps(const std::string& run_dir,
+                                                     const std::vector<eval::Map>& maps,
+                                                     const eval::Map& truth,
+                                                     const std::vector<int>& num_points,
+                                                     int realisations, const Rng& rng,
+                                                     const eval::DivergenceParams& params) {
+  try {
+    return eval::DivergenceStudy(maps[0], maps[1], truth, num_points, realisations, rng, params);
+  } catch (const std::invalid_argument& error) {
+    throw std::runtime_error(rundir::PathIn(run_dir, rundir::MapFile(FilterNames()[0])) + ", " +
+                             rundir::MapFile(FilterNames()[1]) + " and the ground truth of " +
+                             rundir::kConfigFile + "'s world: " + error.what());
+  }
 }
 
 }  // namespace
@@ -88,8 +107,10 @@ RunEvaluation EvaluateRunDirectory(const std::string& run_dir, const EvaluateOpt
   options.match.ValidateOrThrow();
   options.divergence.ValidateOrThrow();
   const nlohmann::json manifest = rundir::ReadManifest(run_dir);
-  const CsvTable trajectory = rundir::ReadCsv(rundir::PathIn(run_dir, rundir::kTrajectoryFile));
-  if (trajectory.rows.empty()) throw std::runtime_error(trajectory.path + ": no rows");
+  // Not while a run (or another evaluation) writes there.
+  const rundir::RunDirectoryLock lock(run_dir);
+  const CsvTable trajectory =
+      rundir::ReadTrajectoryCsv(rundir::PathIn(run_dir, rundir::kTrajectoryFile));
   // A recording without truth (a real log) has no world to compare with.
   if (std::isnan(trajectory.rows[0][1])) {
     throw std::runtime_error(trajectory.path + ": true_x is nan: no true pose to evaluate against "
@@ -102,6 +123,7 @@ RunEvaluation EvaluateRunDirectory(const std::string& run_dir, const EvaluateOpt
   // Poses and maps of both filters.
   std::vector<eval::Map> maps;
   for (const std::string& name : FilterNames()) {
+    ThrowIfInterrupted("evaluation");
     std::vector<eval::PoseStepMetrics> steps = PoseSteps(trajectory, name);
     const std::vector<double> nees = PoseNees(trajectory, name);
     for (std::size_t k = 0; k < steps.size(); ++k) steps[k].nees = nees[k];
@@ -111,9 +133,9 @@ RunEvaluation EvaluateRunDirectory(const std::string& run_dir, const EvaluateOpt
   }
   if (options.divergence_points > 0) {
     const std::uint64_t seed = manifest.value("seed", std::uint64_t{0});
-    const std::vector<eval::DivergenceStatistics> rows = eval::DivergenceStudy(
-        maps[0], maps[1], result.truth, {options.divergence_points},
-        options.divergence_realisations, Rng(seed).Fork("evaluate"), options.divergence);
+    const std::vector<eval::DivergenceStatistics> rows = StudyRunMaps(
+        run_dir, maps, result.truth, {options.divergence_points}, options.divergence_realisations,
+        Rng(seed).Fork("evaluate"), options.divergence);
     result.has_divergence = true;
     result.divergence = {rows[0].mean, rows[1].mean, rows[2].mean, rows[3].mean};
   }
@@ -159,14 +181,14 @@ std::vector<eval::DivergenceStatistics> WriteDivergenceStudy(
     const std::string& out_path, const EvaluateOptions& options) {
   const nlohmann::json manifest = rundir::ReadManifest(run_dir);
   const eval::Map truth = RunGroundTruth(run_dir, options.ground_truth);
-  const eval::Map classical =
-      rundir::ReadMapCsv(rundir::PathIn(run_dir, rundir::MapFile(FilterNames()[0])));
-  const eval::Map selective =
-      rundir::ReadMapCsv(rundir::PathIn(run_dir, rundir::MapFile(FilterNames()[1])));
+  std::vector<eval::Map> maps;
+  for (const std::string& name : FilterNames()) {
+    maps.push_back(rundir::ReadMapCsv(rundir::PathIn(run_dir, rundir::MapFile(name))));
+  }
   const std::uint64_t seed = manifest.value("seed", std::uint64_t{0});
   const std::vector<eval::DivergenceStatistics> rows =
-      eval::DivergenceStudy(classical, selective, truth, num_points, realisations,
-                            Rng(seed).Fork("divergence"), options.divergence);
+      StudyRunMaps(run_dir, maps, truth, num_points, realisations, Rng(seed).Fork("divergence"),
+                   options.divergence);
   std::string text = rundir::HeaderLine(rundir::DivergenceColumns());
   for (const eval::DivergenceStatistics& row : rows) {
     text += std::to_string(row.num_points) + "," + row.pair + "," + rundir::FormatDouble(row.mean) +

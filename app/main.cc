@@ -26,6 +26,7 @@
 #include "app/slurm.h"
 #include "app/sweep.h"
 #include "app/version.h"
+#include "common/interrupt.h"
 #include "config/config.h"
 #include "rundir/layout.h"
 
@@ -34,7 +35,13 @@ namespace {
 
 volatile std::sig_atomic_t g_stop_requested = 0;
 
-void RequestStop(int /*signal*/) { g_stop_requested = 1; }
+// The run and render loops poll g_stop_requested; the other long phases
+// (evaluation, divergence, world setup, plots) throw Interrupted
+// (common/interrupt.h) at their next check.
+void RequestStop(int /*signal*/) {
+  g_stop_requested = 1;
+  RequestInterrupt();
+}
 
 std::string JoinArguments(int argc, char** argv) {
   std::string text;
@@ -614,6 +621,9 @@ int main(int argc, char** argv) {
     for (const auto& [command, execute] : commands) {
       if (command->parsed()) return execute();
     }
+  } catch (const mjslam::Interrupted& interrupted) {
+    std::fprintf(stderr, "mjslam: %s (no partial file written)\n", interrupted.what());
+    return 130;
   } catch (const std::exception& error) {
     // One problem on the line of its prefix; several (a config's) below it.
     const std::string message = error.what();

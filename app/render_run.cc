@@ -1,10 +1,13 @@
 #include "app/render_run.h"
 
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <spawn.h>
 
 #include <algorithm>
+#include <cerrno>
+#include <csignal>
 #include <chrono>
 #include <cmath>
 #include <cstring>
@@ -16,6 +19,7 @@
 #include "app/progress.h"
 #include "app/run_config.h"
 #include "app/scene_frame.h"
+#include "common/interrupt.h"
 #include "renders/scene_renderer.h"
 #include "rundir/csv_reader.h"
 #include "rundir/layout.h"
@@ -38,7 +42,6 @@ struct FilterColumns {
 };
 
 using rundir::CsvTable;
-using rundir::ReadCsv;
 
 // The explorer's sets over time (explorer.csv) as the layers a frame draws.
 struct ExplorerSnapshot {
@@ -79,9 +82,20 @@ void RunReportScript(const std::vector<std::string>& arguments) {
   if (spawned != 0) {
     throw std::runtime_error(std::string("cannot start ") + kPython + " for the plots: " + std::strerror(spawned));
   }
+  // Wait, polling for a stop request: the script is asked to stop (SIGTERM:
+  // it removes its temporary file) and the render ends as interrupted.
   int status = 0;
-  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  bool stopping = false;
+  for (;;) {
+    const pid_t done = ::waitpid(pid, &status, WNOHANG);
+    if (done == pid || (done < 0 && errno != EINTR)) break;
+    if (InterruptRequested() && !stopping) {
+      ::kill(pid, SIGTERM);
+      stopping = true;
+    }
+    ::usleep(20000);
   }
+  ThrowIfInterrupted("plots");
   if (!WIFEXITED(status) || WEXITSTATUS(status) != 0) {
     throw std::runtime_error("renders/report.py failed for '" + arguments.back() + "'");
   }
@@ -90,8 +104,14 @@ void RunReportScript(const std::vector<std::string>& arguments) {
 }  // namespace
 
 bool IsSweepDirectory(const std::string& dir) {
-  return fs::is_directory(fs::path(dir) / rundir::kSweepRunsFolder) &&
-         !fs::exists(fs::path(dir) / rundir::kTrajectoryFile);
+  const fs::path runs = fs::path(dir) / rundir::kSweepRunsFolder;
+  if (!fs::is_directory(runs) || fs::exists(fs::path(dir) / rundir::kTrajectoryFile)) return false;
+  // At least one run folder of a sweep: an empty runs/ is no sweep.
+  std::error_code error;
+  for (const fs::directory_entry& entry : fs::directory_iterator(runs, error)) {
+    if (entry.is_directory()) return true;
+  }
+  return false;
 }
 
 void RenderSweep(const std::string& sweep_dir) { RunReportScript({"sweep", sweep_dir}); }
@@ -107,8 +127,8 @@ class RunPlayback {
       : dir_(dir),
         config_(config),
         min_step_m_(min_step_m),
-        trajectory_(ReadCsv((dir / rundir::kTrajectoryFile).string())),
-        scans_(ReadCsv((dir / rundir::kScansFile).string())),
+        trajectory_(rundir::ReadTrajectoryCsv((dir / rundir::kTrajectoryFile).string())),
+        scans_(rundir::ReadScansCsv((dir / rundir::kScansFile).string())),
         explorer_(ReadExplorer((dir / rundir::kExplorerFile).string())) {
     if (trajectory_.rows.empty()) throw std::runtime_error(trajectory_.path + ": no rows to render");
     t_ = trajectory_.ColumnIndex("t");
@@ -206,7 +226,7 @@ void RenderVideo(const fs::path& dir, const renders::RenderParams& params,
   const auto start = std::chrono::steady_clock::now();
   const double end_t = playback->end_t();
   const double frame_dt = params.speedup / params.fps;
-  const int num_frames = static_cast<int>(std::floor(end_t / frame_dt + 1e-9)) + 1;
+  const int num_frames = params.NumVideoFrames(end_t);
   renders::VideoWriter video((dir / rundir::kVideoFile).string(), params.width, params.height, params.fps, params.crf);
   Progress progress("render", num_frames);
   for (int k = 0; k < num_frames; ++k) {

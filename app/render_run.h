@@ -43,8 +43,8 @@ RenderResult RenderRun(const std::string& run_dir, const renders::RenderParams& 
 /// Throws std::runtime_error when the script fails.
 void RenderSweep(const std::string& sweep_dir);
 
-/// True when `dir` looks like a sweep directory (a runs/ folder and no
-/// trajectory.csv).
+/// True when `dir` looks like a sweep directory: no trajectory.csv, and a
+/// runs/ folder holding at least one folder (a sweep's runs: run_000, ...).
 bool IsSweepDirectory(const std::string& dir);
 
 }  // namespace mjslam::app

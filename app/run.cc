@@ -11,6 +11,7 @@
 #include "app/progress.h"
 #include "app/slam_pair.h"
 #include "app/version.h"
+#include "common/interrupt.h"
 #include "common/params.h"
 #include "config/config.h"
 #include "rundir/csv_writer.h"
@@ -104,6 +105,8 @@ RunResult RunSimulation(const RunConfig& config, const RunOptions& options) {
   // The manifest reads (hashes) the world and robot files: a missing one is
   // an error before anything is written.
   nlohmann::json start_manifest = StartManifest(config, options);
+  // A video of too many frames is refused before the run, not hours into it.
+  if (options.render_video) config.render.NumVideoFrames(config.run.duration_s);
   const rundir::RunDirectoryLock lock(dir);
   rundir::WriteFileAtomically(rundir::PathIn(dir, rundir::kConfigFile), config::ToYaml(config));
   rundir::ManifestWriter manifest(dir, std::move(start_manifest));
@@ -159,6 +162,11 @@ RunResult RunSimulation(const RunConfig& config, const RunOptions& options) {
     result.cpu.coverage_s = loop_cpu.coverage_s;
     result.cpu.filters_s = loop_cpu.filters_s;
     result.cpu.explorer_s = loop_cpu.explorer_s;
+  } catch (const Interrupted&) {
+    // Stopped before the loop (a large world's setup): nothing to resume from.
+    record_progress();
+    manifest.Finish("interrupted");
+    throw;
   } catch (const std::exception& error) {
     record_progress();
     manifest.Fail(error.what());

@@ -107,7 +107,13 @@ bool PlanRun(bool evaluate_runs, PlannedRun* run) {
     run->stage = RunStage::kEvaluate;
     return !evaluated && evaluate_runs;
   }
-  fs::remove_all(run->dir);
+  // A run still alive from an earlier sweep (one killed so hard that its
+  // runs outlived it) holds its folder: refuse rather than delete its files
+  // and start a second writer beside it.
+  if (fs::exists(run->dir)) {
+    const rundir::RunDirectoryLock held(run->dir);
+    fs::remove_all(run->dir);
+  }
   fs::remove(run->dir + ".log");
   run->stage = RunStage::kRun;
   return true;

@@ -5,6 +5,7 @@
 #include <limits>
 
 #include "common/check.h"
+#include "common/interrupt.h"
 
 namespace mjslam::app {
 namespace {
@@ -44,6 +45,7 @@ TrueCoverage::TrueCoverage(const std::vector<sim::ObstacleFootprint>& obstacles,
   // with (grid area) x (number of obstacles).
   Grid2<double> clearance(limits_, std::numeric_limits<double>::infinity());
   for (const sim::ObstacleFootprint& o : obstacles) {
+    ThrowIfInterrupted("world setup (coverage grid)");
     // The footprint's axis-aligned half extents in W, widened.
     Eigen::Vector2d half = Eigen::Vector2d::Constant(o.radius_m);
     if (o.shape == sim::ObstacleFootprint::Shape::kRectangle) {

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <charconv>
+#include <cmath>
 #include <stdexcept>
 #include <string>
 #include <string_view>
@@ -54,15 +55,17 @@ class ParamChecker {
                std::string_view expected) {
     if (!ok) problems_.push_back({std::string(key), ValueText(value), std::string(expected)});
   }
-  /// value > 0.
+  /// value > 0 (and finite: YAML's `.inf` is no size, rate or time).
   template <typename T>
   void Positive(std::string_view key, T value) {
-    Require(value > 0, key, value, "a value > 0");
+    Require(value > 0 && IsFinite(value), key, value,
+            IsFinite(value) ? "a value > 0" : "a finite value > 0");
   }
-  /// value >= 0.
+  /// value >= 0 (and finite).
   template <typename T>
   void NonNegative(std::string_view key, T value) {
-    Require(value >= 0, key, value, "a value >= 0");
+    Require(value >= 0 && IsFinite(value), key, value,
+            IsFinite(value) ? "a value >= 0" : "a finite value >= 0");
   }
   /// lo <= value <= hi.
   template <typename T>
@@ -79,6 +82,15 @@ class ParamChecker {
   const std::vector<ParamProblem>& problems() const { return problems_; }
 
  private:
+  template <typename T>
+  static bool IsFinite(T value) {
+    if constexpr (std::is_floating_point_v<T>) {
+      return std::isfinite(value);
+    } else {
+      return true;
+    }
+  }
+
   std::vector<ParamProblem> problems_;
 };
 

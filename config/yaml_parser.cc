@@ -129,6 +129,22 @@ std::vector<YAML::Mark> DocumentStartMarks(const std::string& text, bool* stuck)
   return handler.starts;
 }
 
+// yaml-cpp's messages for a tab in the indentation often name something
+// else ("illegal map value"): when line `line` (1-based) or the one before
+// it is indented with a tab, says so.
+std::string TabHint(const std::string& text, int line) {
+  std::istringstream lines(text);
+  std::string current;
+  for (int n = 1; std::getline(lines, current) && n <= line; ++n) {
+    if (n < line - 1) continue;
+    const std::size_t indent_end = current.find_first_not_of(" \t");
+    if (current.substr(0, indent_end).find('\t') != std::string::npos) {
+      return " (line " + std::to_string(n) + " is indented with a tab: YAML indents with spaces only)";
+    }
+  }
+  return "";
+}
+
 }  // namespace
 
 ConfigNode ParseYaml(const std::string& text, const std::string& source,
@@ -147,7 +163,7 @@ ConfigNode ParseYaml(const std::string& text, const std::string& source,
       mark.line = error.mark.line + 1;
       mark.column = error.mark.column + 1;
     }
-    problems->push_back({mark, "", "YAML syntax error: " + error.msg});
+    problems->push_back({mark, "", "YAML syntax error: " + error.msg + TabHint(text, mark.line)});
     ConfigNode null_node;
     null_node.mark = start;
     return null_node;

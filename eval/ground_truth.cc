@@ -9,6 +9,7 @@
 
 #include "common/angles.h"
 #include "common/grid2.h"
+#include "common/interrupt.h"
 #include "common/segments.h"
 
 namespace mjslam::eval {
@@ -124,6 +125,7 @@ std::vector<Piece> BoundarySegments(const std::vector<Rectangle>& rects,
   const double tol = params.touch_tolerance_m;
   std::vector<Piece> pieces;
   for (std::size_t i = 0; i < rects.size(); ++i) {
+    ThrowIfInterrupted("ground truth");
     for (int e = 0; e < 4; ++e) {
       const Eigen::Vector2d a = rects[i].corners[e];
       const Eigen::Vector2d b = rects[i].corners[(e + 1) % 4];
@@ -159,6 +161,7 @@ std::vector<Piece> BoundarySegments(const std::vector<Rectangle>& rects,
   // Merge pieces on one line that overlap or touch, until none do.
   bool merged = true;
   while (merged) {
+    ThrowIfInterrupted("ground truth");
     merged = false;
     for (std::size_t i = 0; i < pieces.size() && !merged; ++i) {
       for (std::size_t j = i + 1; j < pieces.size() && !merged; ++j) {

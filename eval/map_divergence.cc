@@ -4,9 +4,12 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+#include <string>
+#include <utility>
 
 #include "common/angles.h"
 #include "common/check.h"
+#include "common/interrupt.h"
 
 namespace mjslam::eval {
 
@@ -127,6 +130,8 @@ std::vector<double> LogPmf(const GaussianMixture& mixture,
   std::vector<double> log_density(points.size());
   std::vector<double> terms(num);
   for (std::size_t i = 0; i < points.size(); ++i) {
+    // A stop request is noticed every 1024 points (well under a second).
+    if (i % 1024 == 0) ThrowIfInterrupted("map divergence");
     double largest = -std::numeric_limits<double>::infinity();
     for (std::size_t k = 0; k < num; ++k) {
       const double dx = points[i].x() - mixture.means[k].x();
@@ -185,9 +190,12 @@ std::vector<DivergenceStatistics> DivergenceStudy(const Map& classical, const Ma
   const GaussianMixture c = MapToMixture(classical, params);
   const GaussianMixture s = MapToMixture(selective, params);
   const GaussianMixture t = MapToMixture(truth, params, MapRole::kTruth);
-  for (const auto* m : {&c, &s, &t}) {
+  const std::pair<const GaussianMixture*, const char*> mixtures[3] = {
+      {&c, "classical"}, {&s, "selective"}, {&t, "truth"}};
+  for (const auto& [m, name] : mixtures) {
     if (m->means.empty()) {
-      throw std::invalid_argument("divergence: a map has no corner and no line with a segment");
+      throw std::invalid_argument(std::string("divergence: the ") + name +
+                                  " map has no corner and no line with a segment");
     }
   }
   std::vector<DivergenceStatistics> rows;
@@ -198,6 +206,7 @@ std::vector<DivergenceStatistics> DivergenceStudy(const Map& classical, const Ma
     }
     std::vector<MapDivergences> samples;
     for (int k = 0; k < realisations; ++k) {
+      ThrowIfInterrupted("map divergence");
       Rng stream = rng.Fork("divergence/" + std::to_string(e) + "/" + std::to_string(k));
       samples.push_back(ComputeMapDivergences(c, s, t, e, &stream, params));
     }

@@ -116,7 +116,10 @@ struct DivergenceStatistics {
 /// `realisations` independent realisations (realisation k at E points draws
 /// from rng.Fork("divergence/E/k"), so every number is reproducible on its
 /// own). Rows in the order of `num_points`, then of the pairs above.
-/// realisations >= 1 and every num_points >= 1 (throw std::invalid_argument).
+/// realisations >= 1 and every num_points >= 1, and each map has a corner or
+/// a line with a segment (else throws std::invalid_argument naming the map:
+/// classical, selective or truth). Throws Interrupted (common/interrupt.h)
+/// within a fraction of a second of a stop request.
 std::vector<DivergenceStatistics> DivergenceStudy(const Map& classical, const Map& selective,
                                                   const Map& truth,
                                                   const std::vector<int>& num_points,

@@ -1,5 +1,8 @@
 #include "renders/render_params.h"
 
+#include <cmath>
+#include <stdexcept>
+
 namespace mjslam::renders {
 
 std::vector<ParamProblem> RenderParams::Validate() const {
@@ -13,6 +16,21 @@ std::vector<ParamProblem> RenderParams::Validate() const {
   check.InRange("crf", crf, 0, 51);
   check.InRange("ellipse_scale", ellipse_scale, 1.0, 1000.0);
   return check.problems();
+}
+
+int RenderParams::NumVideoFrames(double duration_s) const {
+  if (!(duration_s >= 0.0 && std::isfinite(duration_s))) {
+    throw std::runtime_error("video of a run of " + ValueText(duration_s) +
+                             " s: expected a finite duration >= 0");
+  }
+  const double frames = std::floor(duration_s * fps / speedup + 1e-9) + 1.0;
+  if (!(frames <= kMaxVideoFrames)) {
+    throw std::runtime_error("render.speedup = " + ValueText(speedup) + " and render.fps = " +
+                             ValueText(fps) + " give " + ValueText(frames) + " video frames for " +
+                             ValueText(duration_s) + " s (at most " + ValueText(kMaxVideoFrames) +
+                             "): raise the speedup");
+  }
+  return static_cast<int>(frames);
 }
 
 }  // namespace mjslam::renders

@@ -48,6 +48,16 @@ struct RenderParams {
   }
   std::vector<ParamProblem> Validate() const;
   void ValidateOrThrow() const { ThrowIfProblems(Validate()); }
+
+  /// Frames of a video of `duration_s` simulated seconds: one per
+  /// speedup / fps seconds, plus the last. Throws std::runtime_error naming
+  /// render.speedup, render.fps and the count when it exceeds kMaxVideoFrames
+  /// or `duration_s` is not finite and >= 0.
+  int NumVideoFrames(double duration_s) const;
 };
+
+/// Most frames a video may have: 1e6 frames are over 9 hours at 30 frames/s
+/// and hours of rendering; more is a mistaken speedup (1e-6), not a video.
+inline constexpr int kMaxVideoFrames = 1000000;
 
 }  // namespace mjslam::renders

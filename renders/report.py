@@ -16,6 +16,7 @@ import html
 import json
 import math
 import os
+import signal
 import sys
 
 import matplotlib
@@ -49,19 +50,35 @@ def read_csv(path):
     return columns
 
 
+def remove_quietly(path):
+    try:
+        os.remove(path)
+    except OSError:
+        pass
+
+
 def save(fig, path):
-    """Saves a figure atomically (temporary name, then rename)."""
+    """Saves a figure atomically (temporary name, then rename); an error or a
+    stop (SIGTERM, Ctrl-C) leaves no temporary file."""
     temp = path + ".tmp.png"
-    fig.savefig(temp, dpi=DPI, format="png", metadata={"Software": None})
-    plt.close(fig)
-    os.replace(temp, path)
+    try:
+        fig.savefig(temp, dpi=DPI, format="png", metadata={"Software": None})
+        plt.close(fig)
+        os.replace(temp, path)
+    except BaseException:
+        remove_quietly(temp)
+        raise
 
 
 def write_text(path, text):
     temp = path + ".tmp"
-    with open(temp, "w") as f:
-        f.write(text)
-    os.replace(temp, path)
+    try:
+        with open(temp, "w") as f:
+            f.write(text)
+        os.replace(temp, path)
+    except BaseException:
+        remove_quietly(temp)
+        raise
 
 
 def wrap(angle):
@@ -342,5 +359,11 @@ def main(argv):
     return 0
 
 
+def stop(signum, frame):
+    """SIGTERM (mjslam stopping): unwind, so that temporary files are removed."""
+    sys.exit(130)
+
+
 if __name__ == "__main__":
+    signal.signal(signal.SIGTERM, stop)
     sys.exit(main(sys.argv))

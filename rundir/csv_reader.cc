@@ -1,11 +1,14 @@
 #include "rundir/csv_reader.h"
 
+#include <cerrno>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
 #include <limits>
 #include <sstream>
 #include <stdexcept>
+
+#include "rundir/csv_writer.h"
 
 namespace mjslam::rundir {
 namespace {
@@ -35,6 +38,7 @@ CsvTable ReadCsv(const std::string& path, const std::vector<std::string>& text_c
   table.path = path;
   std::string line;
   if (!std::getline(in, line)) throw std::runtime_error(path + ": empty file, expected a header");
+  if (in.eof()) throw std::runtime_error(path + ":1: the header has no line end (the file was cut short)");
   if (!line.empty() && line.back() == '\r') line.pop_back();  // CRLF line ends
   table.columns = SplitFields(line);
   std::vector<bool> is_text(table.columns.size(), false);
@@ -44,6 +48,12 @@ CsvTable ReadCsv(const std::string& path, const std::vector<std::string>& text_c
   int line_number = 1;
   while (std::getline(in, line)) {
     ++line_number;
+    // getline stops at the end of the file without a line end only on a
+    // last row that was cut short.
+    if (in.eof() && !line.empty()) {
+      throw std::runtime_error(path + ":" + std::to_string(line_number) +
+                               ": the last row has no line end (the file was cut short)");
+    }
     if (!line.empty() && line.back() == '\r') line.pop_back();
     if (line.empty()) continue;
     const std::vector<std::string> fields = SplitFields(line);
@@ -65,8 +75,9 @@ CsvTable ReadCsv(const std::string& path, const std::vector<std::string>& text_c
         continue;
       }
       char* end = nullptr;
+      errno = 0;
       row[i] = std::strtod(fields[i].c_str(), &end);
-      if (end == fields[i].c_str() || *end != '\0') {
+      if (end == fields[i].c_str() || *end != '\0' || (errno == ERANGE && std::isinf(row[i]))) {
         throw std::runtime_error(path + ":" + std::to_string(line_number) + ": column " +
                                  table.columns[i] + ": expected a number (got '" + fields[i] +
                                  "')");
@@ -74,8 +85,44 @@ CsvTable ReadCsv(const std::string& path, const std::vector<std::string>& text_c
     }
     table.rows.push_back(std::move(row));
     table.text.push_back(std::move(text));
+    table.lines.push_back(line_number);
   }
   return table;
+}
+
+void CheckLeadingColumns(const CsvTable& table, const std::vector<std::string>& expected) {
+  for (std::size_t c = 0; c < expected.size(); ++c) {
+    if (c >= table.columns.size() || table.columns[c] != expected[c]) {
+      throw std::runtime_error(table.path + ": expected column " + std::to_string(c + 1) +
+                               " to be " + expected[c]);
+    }
+  }
+}
+
+void CheckIncreasingTimes(const CsvTable& table, int column) {
+  for (std::size_t r = 0; r < table.rows.size(); ++r) {
+    const double t = table.rows[r][column];
+    const bool increasing = r == 0 || t > table.rows[r - 1][column];
+    if (!std::isfinite(t) || !increasing) {
+      throw std::runtime_error(table.path + ":" + std::to_string(table.lines[r]) + ": column " +
+                               table.columns[column] +
+                               (std::isfinite(t) ? ": expected a time after the row before's"
+                                                 : ": expected a finite time") +
+                               " (got " + FormatDouble(t) + ")");
+    }
+  }
+}
+
+void CheckValuesInRange(const CsvTable& table, int first, int count, double lo, double hi) {
+  for (std::size_t r = 0; r < table.rows.size(); ++r) {
+    for (int c = first; c < first + count; ++c) {
+      const double value = table.rows[r][c];
+      if (value >= lo && value <= hi) continue;  // false for NaN
+      throw std::runtime_error(table.path + ":" + std::to_string(table.lines[r]) + ": column " +
+                               table.columns[c] + ": expected a number in [" + FormatDouble(lo) +
+                               ", " + FormatDouble(hi) + "] (got " + FormatDouble(value) + ")");
+    }
+  }
 }
 
 }  // namespace mjslam::rundir

@@ -35,7 +35,12 @@ CsvWriter::CsvWriter(const std::string& path, const std::vector<std::string>& co
   }
   for (const std::string& column : columns) Add(column);
   EndRow();
-  Flush();
+  try {
+    Flush();
+  } catch (const std::exception&) {
+    ::close(fd_);  // the destructor does not run for a constructor that throws
+    throw;
+  }
 }
 
 CsvWriter::~CsvWriter() {
@@ -79,15 +84,28 @@ void CsvWriter::EndRow() {
 }
 
 void CsvWriter::Flush() {
+  if (failed_) {
+    buffer_.clear();
+    return;
+  }
   std::size_t written = 0;
   while (written < buffer_.size()) {
     const ssize_t n = ::write(fd_, buffer_.data() + written, buffer_.size() - written);
+    if (n < 0 && errno == EINTR) continue;
     if (n < 0) {
-      if (errno == EINTR) continue;
-      throw std::runtime_error(path_ + ": write failed: " + std::strerror(errno));
+      // A part of the buffer may be on disk: cut the file back to its last
+      // whole row, so that it never ends inside one.
+      const std::string reason = std::strerror(errno);
+      failed_ = true;
+      buffer_.clear();
+      const bool cut = ::ftruncate(fd_, rows_end_) == 0;
+      throw std::runtime_error(path_ + ": write failed: " + reason +
+                               (cut ? " (the file ends at its last whole row)"
+                                    : " (and it could not be cut back to its last whole row)"));
     }
     written += static_cast<std::size_t>(n);
   }
+  rows_end_ += static_cast<off_t>(written);
   buffer_.clear();
 }
 

@@ -1,5 +1,7 @@
 #pragma once
 
+#include <sys/types.h>
+
 #include <string>
 #include <string_view>
 #include <vector>
@@ -27,7 +29,11 @@ class CsvWriter {
   void AddEmpty();
   /// Ends the current row; checks it has as many fields as the header.
   void EndRow();
-  /// Hands every complete row to the kernel. Throws on a write error.
+  /// Hands every complete row to the kernel. On a write error (a full
+  /// disk, a file size limit) cuts the file back to the end of the last row
+  /// that was whole before this flush, drops the rows not written and throws
+  /// std::runtime_error naming the file and the reason; later rows are
+  /// dropped too (the file stays as it was cut).
   void Flush();
 
   const std::string& path() const { return path_; }
@@ -37,6 +43,10 @@ class CsvWriter {
 
   std::string path_;
   int fd_ = -1;
+  // Bytes of whole rows in the file; a failed flush cuts the file back here.
+  off_t rows_end_ = 0;
+  // A flush failed: nothing more is written.
+  bool failed_ = false;
   int num_columns_ = 0;
   int fields_in_row_ = 0;
   std::string row_;

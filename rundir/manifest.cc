@@ -47,7 +47,19 @@ void ManifestWriter::SetLaserMount(const Pose2& X_RS) {
   manifest_["laser_mount"] = {{"x", X_RS.x}, {"y", X_RS.y}, {"th", X_RS.theta}};
 }
 
-void ManifestWriter::Write() const { WriteJsonAtomically(path_, manifest_); }
+void ManifestWriter::Write() const {
+  try {
+    WriteJsonAtomically(path_, manifest_);
+  } catch (const std::exception& atomic_error) {
+    // No room for a second copy: reuse the old file's blocks, or report the
+    // first failure.
+    try {
+      OverwriteFile(path_, manifest_.dump(2) + "\n");
+    } catch (const std::exception&) {
+      throw atomic_error;
+    }
+  }
+}
 
 void ManifestWriter::Finish(const std::string& status) {
   manifest_["status"] = status;
@@ -59,7 +71,11 @@ void ManifestWriter::Fail(const std::string& error) {
   manifest_["status"] = "failed";
   manifest_["error"] = error;
   manifest_["end_time"] = UtcNow();
-  Write();
+  try {
+    Write();
+  } catch (const std::exception& manifest_error) {
+    throw std::runtime_error(error + " (" + manifest_error.what() + ")");
+  }
 }
 
 }  // namespace mjslam::rundir

@@ -25,7 +25,9 @@ std::optional<Pose2> ReadLaserMount(const std::string& manifest_path);
 
 /// The manifest.json of a run directory as a command writes it: at the start
 /// with status "running", again as fields are added, and at the end with the
-/// outcome. Every write is atomic (docs/run_directory.md lists the keys).
+/// outcome. Every write is atomic (docs/run_directory.md lists the keys);
+/// when an atomic write fails (a full disk has no room for the new copy),
+/// the file is overwritten in place, so that the outcome is still recorded.
 class ManifestWriter {
  public:
   /// Writes `fields` plus start_time (now, UTC) and status "running" into
@@ -40,7 +42,9 @@ class ManifestWriter {
   void Write() const;
   /// Sets status, end_time (now) and writes: "completed" or "interrupted".
   void Finish(const std::string& status);
-  /// Sets status "failed", `error`, end_time (now) and writes.
+  /// Sets status "failed", `error`, end_time (now) and writes. When even
+  /// that write fails, throws std::runtime_error whose message is `error`
+  /// first (the file that failed) and then why the manifest could not say so.
   void Fail(const std::string& error);
 
  private:

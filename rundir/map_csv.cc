@@ -62,6 +62,11 @@ FeatureMap ReadMapCsv(const std::string& path) {
     const std::string& kind = table.text[r][0];  // the only text column
     const std::string where = path + ":" + std::to_string(r + 2) + ": ";
     MapFeature f;
+    // A whole number that fits an int (a cast of NaN or 1e308 is undefined).
+    if (!(row[id] >= 0.0 && row[id] <= 1e9 && std::floor(row[id]) == row[id])) {
+      throw std::runtime_error(where + "id: expected a whole number in [0, 1e9] (got " +
+                               FormatDouble(row[id]) + ")");
+    }
     f.id = static_cast<int>(row[id]);
     if (kind == "line") {
       f.type = MapFeature::Type::kLine;

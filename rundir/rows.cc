@@ -78,6 +78,51 @@ void AddExplorerRows(const ExplorerSnapshot& snapshot, CsvWriter* explorer) {
   }
 }
 
+namespace {
+
+// The true pose (columns 1-3): finite and in range everywhere, or NaN
+// everywhere in a recording that has no truth (a real log written by
+// mjslam import).
+void CheckTruePoseColumns(const CsvTable& table) {
+  if (table.rows.empty() || !std::isnan(table.rows[0][1])) {
+    CheckValuesInRange(table, 1, 3, -kMaxRecordedCoordinateM, kMaxRecordedCoordinateM);
+    return;
+  }
+  for (std::size_t r = 0; r < table.rows.size(); ++r) {
+    for (int c = 1; c <= 3; ++c) {
+      if (std::isnan(table.rows[r][c])) continue;
+      throw std::runtime_error(table.path + ":" + std::to_string(table.lines[r]) + ": column " +
+                               table.columns[c] + ": expected nan, as in the first row (a " +
+                               "recording without truth) (got " +
+                               FormatDouble(table.rows[r][c]) + ")");
+    }
+  }
+}
+
+}  // namespace
+
+CsvTable ReadTrajectoryCsv(const std::string& path) {
+  CsvTable table = ReadCsv(path);
+  if (table.rows.empty()) throw std::runtime_error(path + ": no rows");
+  const std::vector<std::string> expected = RecordedTrajectoryColumns();
+  CheckLeadingColumns(table, expected);
+  CheckIncreasingTimes(table, 0);
+  CheckTruePoseColumns(table);
+  const int count = static_cast<int>(expected.size()) - 4;
+  CheckValuesInRange(table, 4, count, -kMaxRecordedCoordinateM, kMaxRecordedCoordinateM);
+  return table;
+}
+
+CsvTable ReadScansCsv(const std::string& path) {
+  CsvTable table = ReadCsv(path);
+  CheckLeadingColumns(table, {"t", "x", "y", "th"});
+  CheckIncreasingTimes(table, 0);
+  CheckTruePoseColumns(table);
+  const int num_ranges = static_cast<int>(table.columns.size()) - kScanRangesStart;
+  CheckValuesInRange(table, kScanRangesStart, num_ranges, 0.0, kMaxRecordedCoordinateM);
+  return table;
+}
+
 std::vector<ExplorerSnapshot> ReadExplorerCsv(const std::string& path) {
   std::vector<ExplorerSnapshot> snapshots;
   if (!std::filesystem::exists(path)) return snapshots;

@@ -10,6 +10,7 @@
 
 #include "common/pose2.h"
 #include "common/records.h"
+#include "rundir/csv_reader.h"
 #include "rundir/csv_writer.h"
 
 namespace mjslam::rundir {
@@ -74,6 +75,25 @@ struct ExplorerSnapshot {
 /// Appends the rows of `snapshot` to an explorer.csv writer: kind
 /// "frontier", "goal" and "path", each with its index.
 void AddExplorerRows(const ExplorerSnapshot& snapshot, CsvWriter* explorer);
+
+/// Coordinates and ranges beyond this are no building's (metres): a damaged
+/// file, not a run.
+inline constexpr double kMaxRecordedCoordinateM = 1e6;
+
+/// Reads a trajectory.csv: at least one row; the recorded columns
+/// (RecordedTrajectoryColumns()) first, in order; times finite and
+/// increasing; odometry poses and commands finite, within
+/// kMaxRecordedCoordinateM; true poses the same, or NaN in every row (a
+/// recording without truth, as mjslam import writes). Throws std::runtime_error naming the file, line,
+/// column and value of the first problem.
+CsvTable ReadTrajectoryCsv(const std::string& path);
+
+/// Reads a scans.csv: columns t, x, y, th, then ranges; times finite and
+/// increasing; true laser poses finite (or NaN in every row: a recording
+/// without truth), ranges in [0, kMaxRecordedCoordinateM] metres. No rows is allowed (a run too short to scan). Throws
+/// std::runtime_error naming the file, line, column and value of the first
+/// problem.
+CsvTable ReadScansCsv(const std::string& path);
 
 /// Reads explorer.csv into its snapshots, in the order of time (rows of one
 /// time form one snapshot; path points sorted by index). A missing file

@@ -16,32 +16,48 @@
 
 namespace mjslam::rundir {
 
+namespace {
+
+// Writes all of `contents` to `fd`; on failure returns the reason.
+std::string WriteAll(int fd, const std::string& contents) {
+  std::size_t written = 0;
+  while (written < contents.size()) {
+    const ssize_t n = ::write(fd, contents.data() + written, contents.size() - written);
+    if (n < 0 && errno == EINTR) continue;
+    if (n < 0) return std::strerror(errno);
+    written += static_cast<std::size_t>(n);
+  }
+  return "";
+}
+
+}  // namespace
+
 void WriteFileAtomically(const std::string& path, const std::string& contents) {
   const std::string temporary = path + ".tmp";
-  {
-    const int fd = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-    if (fd < 0) {
-      throw std::runtime_error(path + ": cannot write: " + std::strerror(errno));
-    }
-    std::size_t written = 0;
-    while (written < contents.size()) {
-      const ssize_t n = ::write(fd, contents.data() + written, contents.size() - written);
-      if (n < 0 && errno == EINTR) continue;
-      if (n < 0) {
-        const std::string reason = std::strerror(errno);
-        ::close(fd);
-        std::remove(temporary.c_str());
-        throw std::runtime_error(path + ": write failed: " + reason);
-      }
-      written += static_cast<std::size_t>(n);
-    }
-    ::close(fd);
+  const int fd = ::open(temporary.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+  if (fd < 0) throw std::runtime_error(path + ": cannot write: " + std::strerror(errno));
+  const std::string reason = WriteAll(fd, contents);
+  ::close(fd);
+  if (!reason.empty()) {
+    std::remove(temporary.c_str());
+    throw std::runtime_error(path + ": write failed: " + reason);
   }
   if (std::rename(temporary.c_str(), path.c_str()) != 0) {
-    const std::string reason = std::strerror(errno);
+    const std::string rename_reason = std::strerror(errno);
     std::remove(temporary.c_str());
-    throw std::runtime_error(path + ": cannot replace: " + reason);
+    throw std::runtime_error(path + ": cannot replace: " + rename_reason);
   }
+}
+
+void OverwriteFile(const std::string& path, const std::string& contents) {
+  const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC, 0644);
+  if (fd < 0) throw std::runtime_error(path + ": cannot write: " + std::strerror(errno));
+  std::string reason = WriteAll(fd, contents);
+  if (reason.empty() && ::ftruncate(fd, static_cast<off_t>(contents.size())) != 0) {
+    reason = std::strerror(errno);
+  }
+  ::close(fd);
+  if (!reason.empty()) throw std::runtime_error(path + ": write failed: " + reason);
 }
 
 void WriteJsonAtomically(const std::string& path, const nlohmann::json& value) {

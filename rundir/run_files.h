@@ -11,6 +11,13 @@ namespace mjslam::rundir {
 /// std::runtime_error naming the file on failure.
 void WriteFileAtomically(const std::string& path, const std::string& contents);
 
+/// Writes `contents` over the file at `path` in place (no truncation first,
+/// then cut to the new size): the blocks the old file holds are reused, so on
+/// a full disk a file no larger than the old one's blocks is still written.
+/// Not atomic: for recording an outcome when WriteFileAtomically failed.
+/// Throws std::runtime_error naming the file on failure.
+void OverwriteFile(const std::string& path, const std::string& contents);
+
 /// Pretty-printed JSON, written atomically.
 void WriteJsonAtomically(const std::string& path, const nlohmann::json& value);
 

@@ -86,13 +86,26 @@ struct Contexts {
 // and line number. mj_loadXML is not trapped (its parser is C++, so an
 // error could not be longjmp'd over): it reports through its error buffer,
 // and MuJoCo 2.2's compiler traps its own engine errors there.
-void LoadAlone(const std::string& kind, const std::string& path) {
+internal::ModelPtr LoadAlone(const std::string& kind, const std::string& path) {
   char error[1024] = "";
-  mjModel* alone = mj_loadXML(path.c_str(), nullptr, error, sizeof(error));
+  internal::ModelPtr alone(mj_loadXML(path.c_str(), nullptr, error, sizeof(error)));
   if (alone == nullptr) {
     throw SimError("cannot load " + kind + " '" + path + "': " + std::string(error));
   }
-  mj_deleteModel(alone);
+  return alone;
+}
+
+// A world must not set <option> (worlds/README.md): the robot model's options
+// govern the composed scene. Loaded alone, the world has MuJoCo's default
+// options unless it sets some (mjOption is doubles then ints: no padding).
+void CheckWorldSetsNoOption(const mjModel& world_alone, const std::string& world_context) {
+  mjOption defaults;
+  mj_defaultOption(&defaults);
+  static_assert(sizeof(mjOption) == 25 * sizeof(mjtNum) + 10 * sizeof(int));
+  if (std::memcmp(&world_alone.opt, &defaults, sizeof(mjOption)) != 0) {
+    throw SimError(world_context + " sets <option>: worlds must not (the robot model's options "
+                   "govern the scene and the simulator sets the timestep)");
+  }
 }
 
 // The wrapper MJCF that includes the world and the robot. It lives
@@ -311,7 +324,7 @@ std::shared_ptr<const Scene::Impl> Scene::Load(const std::string& world_in,
   if (world.filename() == kSceneFileName) {
     throw SimError("world file '" + scene->world_path + "' must not be named " + kSceneFileName);
   }
-  LoadAlone("world", scene->world_path);
+  const internal::ModelPtr world_alone = LoadAlone("world", scene->world_path);
   LoadAlone("robot model", scene->robot_path);
   scene->model = LoadComposed(world, CompositionXml(world, robot_file),
                               DescribeFiles(scene->world_path, scene->robot_path));
@@ -323,6 +336,7 @@ std::shared_ptr<const Scene::Impl> Scene::Load(const std::string& world_in,
   scene->robot = FindRobot(m, context.robot);
   CheckGeomGroups(m, scene->robot, context);
   CheckWorldIsStatic(m, scene->robot, context.world);
+  CheckWorldSetsNoOption(*world_alone, context.world);
   const int start_site = FindStartSite(m, context.world);
   const std::vector<int> tour_sites = FindTourSites(m, context.world);
   scene->wheel_radius_m = WheelRadii(m, scene->robot, context.robot);

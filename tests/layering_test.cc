@@ -15,8 +15,9 @@ namespace {
 namespace fs = std::filesystem;
 
 // Project folders that hold code.
-const std::set<std::string> kCodeFolders = {"common", "config",   "sim",     "slam", "explorer",
-                                            "eval",   "rundir",   "realdata", "renders", "app"};
+const std::set<std::string> kCodeFolders = {"common", "config",   "sim",     "slam",
+                                            "explorer", "eval",   "rundir",  "realdata",
+                                            "renders", "app",     "fuzz"};
 
 // What each folder may include from the project and from outside.
 struct Rule {
@@ -40,6 +41,9 @@ Rule RuleFor(const std::string& folder) {
   if (folder == "config") return {{"common", "config"}, false, true, false, true};
   if (folder == "sim") return {{"common", "sim"}, true, false, false, true};
   if (folder == "renders") return {kCodeFolders, true, false, true, true};
+  // The fuzz targets read inputs as the program does: config, rundir, and
+  // app's RunConfig; no MuJoCo, YAML or GL of their own.
+  if (folder == "fuzz") return {{"common", "config", "rundir", "app", "fuzz"}, false, false, false, true};
   return {kCodeFolders, false, false, false, true};  // app
 }
 

@@ -130,6 +130,23 @@ TEST(ConfigTest, ReadsNegativeIntAndSpecialDoubles) {
   EXPECT_TRUE(local.flag);
 }
 
+// yaml-cpp says "illegal map value" for some tab indentations; the error
+// must say what is wrong.
+TEST(ConfigTest, TabIndentationErrorSaysTab) {
+  for (const char* text : {"laser:\n\tgain: 1.0\n", "laser:\n  gain: 1.0\n\toffset_m: [1, 2, 3]\n"}) {
+    const std::string message = ErrorOf(text);
+    EXPECT_TRUE(Contains(message, "indented with a tab")) << message;
+    EXPECT_EQ(LineCount(message), 1u) << message;
+  }
+}
+
+// `.inf` is YAML for infinity, and no rate, size or time.
+TEST(ConfigTest, InfinityIsRefusedForAPositiveKey) {
+  const std::string message = ErrorOf("rate_hz: .inf\n");
+  EXPECT_TRUE(Contains(message, "x.yaml:1:10: rate_hz: expected a finite value > 0 (got inf)"))
+      << message;
+}
+
 TEST(ConfigTest, UnknownKeyListsKnownKeysWithLineCol) {
   const std::string message = ErrorOf(
       "rate_hz: 1\n"

@@ -1,3 +1,8 @@
+#include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <csignal>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -103,6 +108,57 @@ TEST(CsvTest, UnwritableFileIsAnErrorNamingIt) {
   } catch (const std::runtime_error& error) {
     EXPECT_NE(std::string(error.what()).find("/nonexistent-folder/x.csv"), std::string::npos);
   }
+}
+
+// A file size limit stands for a full disk: write() fails the same way
+// (EFBIG instead of ENOSPC) once the file reaches it, after writing part of
+// the buffer. The writer runs in a child process, whose limit ends with it.
+TEST(CsvTest, FullDiskLeavesWholeRowsAndNamesTheFile) {
+  const std::string path = TempPath("full.csv");
+  const std::string message_path = TempPath("full.message");
+  std::filesystem::remove(path);
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    std::signal(SIGXFSZ, SIG_IGN);
+    const rlimit limit{10000, 10000};
+    ::setrlimit(RLIMIT_FSIZE, &limit);
+    std::string message = "no error";
+    try {
+      CsvWriter writer(path, {"t", "x", "y"});
+      for (int i = 0; i < 100000; ++i) {
+        writer.Add(i * 0.1);
+        writer.Add(1.0 / (i + 3));
+        writer.Add(-2.0 / (i + 7));
+        writer.EndRow();
+        // Flushes of a few rows, as a run's: the one that hits the limit
+        // is written in part.
+        if (i % 7 == 6) writer.Flush();
+      }
+      writer.Flush();
+    } catch (const std::exception& error) {
+      message = error.what();
+    }
+    std::ofstream(message_path) << message;
+    ::_exit(0);
+  }
+  int status = 0;
+  ::waitpid(child, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status));
+  std::ifstream message_in(message_path);
+  std::stringstream message;
+  message << message_in.rdbuf();
+  EXPECT_NE(message.str().find(path + ": write failed"), std::string::npos) << message.str();
+  EXPECT_NE(message.str().find("last whole row"), std::string::npos) << message.str();
+  // The file ends at a row boundary and reads back whole.
+  std::ifstream in(path);
+  std::stringstream text;
+  text << in.rdbuf();
+  ASSERT_FALSE(text.str().empty());
+  EXPECT_EQ(text.str().back(), '\n');
+  EXPECT_LE(text.str().size(), 10000u);
+  const CsvTable table = ReadCsv(path);
+  EXPECT_GT(table.rows.size(), 100u);
 }
 
 }  // namespace

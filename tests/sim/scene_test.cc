@@ -197,6 +197,22 @@ TEST_F(SceneTest, WorldWithAMovingBodyOrAnActuator) {
   EXPECT_TRUE(Contains(actuator, "adds actuators")) << actuator;
 }
 
+// worlds/README.md: a world must not set <option> (it would be silently
+// overridden by, or fight with, the robot model's and the simulator's).
+TEST_F(SceneTest, WorldSettingOptionIsRefusedNamingTheElement) {
+  for (const char* option : {"<option timestep=\"0.01\"/>", "<option gravity=\"0 0 -1\"/>",
+                             "<option><flag contact=\"disable\"/></option>"}) {
+    const std::string world_file = WriteTempFile(
+        "option_world.xml", std::string("<mujoco>\n  ") + option +
+                                "\n  <worldbody>\n    <geom name=\"floor\" type=\"plane\" "
+                                "size=\"50 50 0.1\"/>\n    <site name=\"start\"/>\n  "
+                                "</worldbody>\n</mujoco>\n");
+    const std::string message = SceneError(world_file);
+    EXPECT_TRUE(Contains(message, "sets <option>")) << option << ": " << message;
+    EXPECT_TRUE(Contains(message, "option_world.xml")) << message;
+  }
+}
+
 TEST_F(SceneTest, TourSitesWithAGapOrABadName) {
   const std::string gap = SceneError(WriteTempFile(
       "tour_gap.xml", WorldXml("<site name=\"tour_0\" pos=\"1 0 0\"/>"
