@@ -26,6 +26,7 @@ class World:
         self.tour = []
         self.start = None
         self.extent = None
+        self.thickness = T  # wall thickness named in the file's comment
     def box(self, name, cx, cy, hx, hy, yaw_deg=0.0):
         self.boxes.append((name, cx, cy, hx, hy, yaw_deg))
     def wall(self, name, x0, y0, x1, y1, ext0=True, ext1=True, t=T):
@@ -83,7 +84,7 @@ class World:
         out.append(f'    <light name="sun" directional="true" pos="{fmt(fx)} {fmt(fy)} 8" dir="0 0 -1" diffuse="0.7 0.7 0.7"/>')
         out.append(f'    <geom name="floor" type="plane" pos="{fmt(fx)} {fmt(fy)} 0" size="{fmt(hx)} {fmt(hy)} 0.1" material="floor_mat"/>')
         out.append('')
-        out.append(f'    <!-- Walls: boxes {fmt(T)} m thick, {fmt(H)} m tall (yaw in degrees). -->')
+        out.append(f'    <!-- Walls: boxes {fmt(self.thickness)} m thick, {fmt(H)} m tall (yaw in degrees). -->')
         for (name, cx, cy, hx_, hy_, yaw) in self.boxes:
             e = f' euler="0 0 {fmt(yaw)}"' if abs(yaw) > 1e-9 else ''
             out.append(f'    <geom name="{name}" type="box" material="wall_mat" size="{fmt(hx_)} {fmt(hy_)} {fmt(H/2)}" pos="{fmt(cx)} {fmt(cy)} {fmt(H/2)}"{e}/>')
