@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "common/check.h"
 
@@ -14,6 +15,35 @@ constexpr double kFreeMargin = 0.03;
 constexpr double kBorder = 1.0;
 
 }  // namespace
+
+Grid2<double> ClearanceGrid(const std::vector<sim::ObstacleFootprint>& obstacles,
+                            const GridLimits& limits, double cutoff_m) {
+  // Each obstacle updates only the cells within the cutoff of its bounds, so
+  // the cost grows with the obstacles' area, not with obstacles times cells.
+  Grid2<double> clearance(limits, std::numeric_limits<double>::infinity());
+  for (const sim::ObstacleFootprint& o : obstacles) {
+    Eigen::Vector2d box_lo(o.X_WO.x, o.X_WO.y);
+    Eigen::Vector2d box_hi = box_lo;
+    if (o.shape == sim::ObstacleFootprint::Shape::kCircle) {
+      box_lo.array() -= o.radius_m;
+      box_hi.array() += o.radius_m;
+    } else {
+      for (const Eigen::Vector2d& c : sim::RectangleCorners(o)) {
+        box_lo = box_lo.cwiseMin(c);
+        box_hi = box_hi.cwiseMax(c);
+      }
+    }
+    const Eigen::Vector2i lo = limits.CellOf(box_lo - Eigen::Vector2d::Constant(cutoff_m));
+    const Eigen::Vector2i hi = limits.CellOf(box_hi + Eigen::Vector2d::Constant(cutoff_m));
+    for (int j = std::max(0, lo.y()); j <= std::min(limits.height() - 1, hi.y()); ++j) {
+      for (int i = std::max(0, lo.x()); i <= std::min(limits.width() - 1, hi.x()); ++i) {
+        clearance(i, j) =
+            std::min(clearance(i, j), sim::DistanceToFootprint(limits.CellCenter(i, j), o));
+      }
+    }
+  }
+  return clearance;
+}
 
 TrueCoverage::TrueCoverage(const std::vector<sim::ObstacleFootprint>& obstacles,
                            const Eigen::Vector2d& p_W_start, double cell_m,
@@ -35,13 +65,9 @@ TrueCoverage::TrueCoverage(const std::vector<sim::ObstacleFootprint>& obstacles,
   const int width = limits_.width();
   const int height = limits_.height();
 
-  // Clearance of every cell centre.
-  Grid2<double> clearance(limits_);
-  for (int j = 0; j < height; ++j) {
-    for (int i = 0; i < width; ++i) {
-      clearance(i, j) = sim::DistanceToObstacles(limits_.CellCenter(i, j), obstacles);
-    }
-  }
+  // Clearance of every cell centre; both thresholds below are within the
+  // cutoff, so they see the exact clearance.
+  const Grid2<double> clearance = ClearanceGrid(obstacles, limits_, robot_radius_m + cell_m);
 
   // Where the robot can stand, connected to the start.
   const int start = Index(p_W_start);
