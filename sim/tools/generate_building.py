@@ -339,13 +339,23 @@ def plan_tour(b, corridor_y, cross_x, rooms_by_corridor):
         if not east:
             tour.append((end_x[1], mid[ci]))  # drive to the east end first
         for r in rooms:
-            c = (r.door_x, mid[ci])
+            # On the door's axis: across the corridor (a run-up to align with
+            # the door), just before and just after the door, and deep in the
+            # room; then the room's middle, and back the same way.
+            face = r.door_y - r.axis_y * a.wall_thickness / 2
+            c = (r.door_x, face - r.axis_y * (cw - TOUR_CLEARANCE_M - 0.05))
             out = (r.door_x, r.door_y - r.axis_y * DOOR_APPROACH_M)
             inside = (r.door_x, r.door_y + r.axis_y * DOOR_APPROACH_M)
+            depth = r.y1 - r.y0
+            deep = (r.door_x, face + r.axis_y * (a.wall_thickness +
+                                                 min(depth - TURN_CLEARANCE_M, 2.4)))
             middle = room_middle(r)
+            visit = [deep]
+            if math.hypot(middle[0] - deep[0], middle[1] - deep[1]) > 0.5:
+                visit += [middle, deep]
             tour += [c, out]
             b.door_legs[len(tour) - 1] = r
-            tour += [inside, middle, inside]
+            tour += [inside] + visit + [inside]
             b.door_legs[len(tour) - 1] = r
             tour += [out, c]
         tour.append((end_x[1] if east else end_x[0], mid[ci]))
