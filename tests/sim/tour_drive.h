@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -24,8 +25,11 @@ inline double TourLength(const std::vector<Eigen::Vector2d>& tour) {
 
 /// Drives the tour once with a proportional controller on the point h (the
 /// offset a makes its kinematics invertible, Eq. (6)), checking for contacts
-/// every 0.1 s. Returns the distance driven by h.
-inline double DriveTour(Simulator* sim, double speed_mps) {
+/// every 0.1 s, until the tour is closed or h has driven `max_driven_m`.
+/// Fails as stuck when no waypoint is reached within 60 s plus the time the
+/// leg needs at `speed_mps`. Returns the distance driven by h.
+inline double DriveTour(Simulator* sim, double speed_mps,
+                        double max_driven_m = std::numeric_limits<double>::infinity()) {
   const std::vector<Eigen::Vector2d>& tour = sim->scene().TourWaypoints();
   const double a = sim->robot().control_point_offset_m;
   std::size_t target = 1;
@@ -33,7 +37,7 @@ inline double DriveTour(Simulator* sim, double speed_mps) {
   double driven = 0.0;
   Eigen::Vector2d last = sim->X_WR().translation();
   double last_progress_s = 0.0;
-  while (reached < tour.size()) {
+  while (reached < tour.size() && driven < max_driven_m) {
     const Pose2 X_WR = sim->X_WR();
     const Eigen::Vector2d error = tour[target % tour.size()] - X_WR.translation();
     if (error.norm() < 0.25) {
@@ -53,7 +57,9 @@ inline double DriveTour(Simulator* sim, double speed_mps) {
     last = sim->X_WR().translation();
     EXPECT_EQ(sim->CountRobotWorldContacts(), 0)
         << "contact at t = " << sim->time_s() << " s near tour_" << target % tour.size();
-    if (sim->CountRobotWorldContacts() > 0 || sim->time_s() - last_progress_s > 60.0) {
+    const double leg_s = (tour[target % tour.size()] - tour[(target - 1) % tour.size()]).norm() /
+                         speed_mps;
+    if (sim->CountRobotWorldContacts() > 0 || sim->time_s() - last_progress_s > 60.0 + leg_s) {
       ADD_FAILURE() << "stuck before tour_" << target % tour.size();
       break;
     }
