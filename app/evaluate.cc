@@ -52,13 +52,9 @@ std::vector<eval::DivergenceStatistics> StudyRunMaps(const std::string& run_dir,
 
 }  // namespace
 
-eval::Map RunGroundTruth(const std::string& run_dir, const eval::GroundTruthParams& params) {
-  const std::string config_path = rundir::PathIn(run_dir, rundir::kConfigFile);
-  if (!std::filesystem::is_regular_file(config_path)) {
-    throw std::runtime_error(config_path + ": missing (is '" + run_dir + "' a run directory?)");
-  }
-  const RunConfig config = LoadRunConfig(config_path, {});
-  const sim::Scene scene(config.run.world, config.run.robot_model);
+eval::Map WorldGroundTruth(const std::string& world, const std::string& robot_model,
+                           const eval::GroundTruthParams& params) {
+  const sim::Scene scene(world, robot_model);
   std::vector<eval::WallRectangle> walls;
   for (const sim::ObstacleFootprint& obstacle : scene.Obstacles()) {
     if (obstacle.shape != sim::ObstacleFootprint::Shape::kRectangle) continue;
@@ -70,8 +66,17 @@ eval::Map RunGroundTruth(const std::string& run_dir, const eval::GroundTruthPara
     return eval::ReachableFeatures(eval::BuildGroundTruthMap(walls, params), walls,
                                    scene.StartPose().translation());
   } catch (const std::invalid_argument& error) {
-    throw std::runtime_error(config.run.world + ": " + error.what());
+    throw std::runtime_error(world + ": " + error.what());
   }
+}
+
+eval::Map RunGroundTruth(const std::string& run_dir, const eval::GroundTruthParams& params) {
+  const std::string config_path = rundir::PathIn(run_dir, rundir::kConfigFile);
+  if (!std::filesystem::is_regular_file(config_path)) {
+    throw std::runtime_error(config_path + ": missing (is '" + run_dir + "' a run directory?)");
+  }
+  const RunConfig config = LoadRunConfig(config_path, {});
+  return WorldGroundTruth(config.run.world, config.run.robot_model, params);
 }
 
 std::vector<eval::PoseStepMetrics> PoseSteps(const CsvTable& trajectory, const std::string& name) {

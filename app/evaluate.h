@@ -36,13 +36,17 @@ struct RunEvaluation {
   eval::MapDivergences divergence;
 };
 
-/// The true map of the run's world: the wall (box) footprints of
-/// sim::Scene::Obstacles() of the world in the run's config.yaml (no physics
-/// is run), through eval::BuildGroundTruthMap, restricted to the features
-/// that face the free space reachable from the world's start site
-/// (eval::ReachableFeatures); pillars (round or other non-box geoms) are left
-/// out. Throws naming the file when the run directory's config or world
-/// cannot be loaded.
+/// The true map of a world file: the wall (box) footprints of
+/// sim::Scene::Obstacles() (no physics is run), through
+/// eval::BuildGroundTruthMap, restricted to the features that face the free
+/// space reachable from the world's start site (eval::ReachableFeatures);
+/// pillars (round or other non-box geoms) are left out. Throws naming the
+/// world when it cannot be loaded or a wall is not a rectangle.
+eval::Map WorldGroundTruth(const std::string& world, const std::string& robot_model,
+                           const eval::GroundTruthParams& params = {});
+
+/// WorldGroundTruth of the world in the run's config.yaml. Throws naming the
+/// file when the run directory's config or world cannot be loaded.
 eval::Map RunGroundTruth(const std::string& run_dir, const eval::GroundTruthParams& params = {});
 
 /// The pose metrics (error, NEES, inside 2 sigma) of filter `name` at every

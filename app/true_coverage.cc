@@ -17,6 +17,36 @@ constexpr double kBorder = 1.0;
 
 }  // namespace
 
+Grid2<double> ClearanceGrid(const std::vector<sim::ObstacleFootprint>& obstacles,
+                            const GridLimits& limits, double cutoff_m) {
+  // Each obstacle updates only the cells within the cutoff of its bounds, so
+  // the cost grows with the obstacles' area, not with obstacles times cells.
+  Grid2<double> clearance(limits, std::numeric_limits<double>::infinity());
+  for (const sim::ObstacleFootprint& o : obstacles) {
+    ThrowIfInterrupted("world setup (coverage grid)");
+    Eigen::Vector2d box_lo(o.X_WO.x, o.X_WO.y);
+    Eigen::Vector2d box_hi = box_lo;
+    if (o.shape == sim::ObstacleFootprint::Shape::kCircle) {
+      box_lo.array() -= o.radius_m;
+      box_hi.array() += o.radius_m;
+    } else {
+      for (const Eigen::Vector2d& c : sim::RectangleCorners(o)) {
+        box_lo = box_lo.cwiseMin(c);
+        box_hi = box_hi.cwiseMax(c);
+      }
+    }
+    const Eigen::Vector2i lo = limits.CellOf(box_lo - Eigen::Vector2d::Constant(cutoff_m));
+    const Eigen::Vector2i hi = limits.CellOf(box_hi + Eigen::Vector2d::Constant(cutoff_m));
+    for (int j = std::max(0, lo.y()); j <= std::min(limits.height() - 1, hi.y()); ++j) {
+      for (int i = std::max(0, lo.x()); i <= std::min(limits.width() - 1, hi.x()); ++i) {
+        clearance(i, j) =
+            std::min(clearance(i, j), sim::DistanceToFootprint(limits.CellCenter(i, j), o));
+      }
+    }
+  }
+  return clearance;
+}
+
 TrueCoverage::TrueCoverage(const std::vector<sim::ObstacleFootprint>& obstacles,
                            const Eigen::Vector2d& p_W_start, double cell_m,
                            double robot_radius_m) {
@@ -37,34 +67,9 @@ TrueCoverage::TrueCoverage(const std::vector<sim::ObstacleFootprint>& obstacles,
   const int width = limits_.width();
   const int height = limits_.height();
 
-  // Clearance of the cell centres, where it matters: only whether it is at
-  // least robot_radius_m and more than kFreeMargin is used below, so each
-  // obstacle sets the cells within robot_radius_m of its bounding box (the
-  // exact distance, the smallest over the obstacles near the cell) and every
-  // other cell keeps +infinity. The cost grows with the obstacles' area, not
-  // with (grid area) x (number of obstacles).
-  Grid2<double> clearance(limits_, std::numeric_limits<double>::infinity());
-  for (const sim::ObstacleFootprint& o : obstacles) {
-    ThrowIfInterrupted("world setup (coverage grid)");
-    // The footprint's axis-aligned half extents in W, widened.
-    Eigen::Vector2d half = Eigen::Vector2d::Constant(o.radius_m);
-    if (o.shape == sim::ObstacleFootprint::Shape::kRectangle) {
-      const double c = std::abs(std::cos(o.X_WO.theta));
-      const double s = std::abs(std::sin(o.X_WO.theta));
-      half = Eigen::Vector2d(c * o.half_extents_m.x() + s * o.half_extents_m.y(),
-                             s * o.half_extents_m.x() + c * o.half_extents_m.y());
-    }
-    half.array() += robot_radius_m + cell_m;
-    const Eigen::Vector2d p_WO(o.X_WO.x, o.X_WO.y);
-    const Eigen::Vector2i lo_cell = limits_.CellOf(p_WO - half);
-    const Eigen::Vector2i hi_cell = limits_.CellOf(p_WO + half);
-    for (int j = std::max(0, lo_cell.y()); j <= std::min(height - 1, hi_cell.y()); ++j) {
-      for (int i = std::max(0, lo_cell.x()); i <= std::min(width - 1, hi_cell.x()); ++i) {
-        const double distance = sim::DistanceToFootprint(limits_.CellCenter(i, j), o);
-        clearance(i, j) = std::min(clearance(i, j), distance);
-      }
-    }
-  }
+  // Clearance of every cell centre; both thresholds below are within the
+  // cutoff, so they see the exact clearance.
+  const Grid2<double> clearance = ClearanceGrid(obstacles, limits_, robot_radius_m + cell_m);
 
   // Where the robot can stand, connected to the start.
   const int start = Index(p_W_start);

@@ -12,6 +12,14 @@
 
 namespace mjslam::app {
 
+/// The distance from each cell centre of `limits` to the nearest of
+/// `obstacles` (sim::DistanceToObstacles), exact where it is at most
+/// `cutoff_m`; elsewhere some value above `cutoff_m` (infinity when no
+/// obstacle is near). Costs about the cells within the cutoff of each
+/// obstacle, not cells times obstacles.
+Grid2<double> ClearanceGrid(const std::vector<sim::ObstacleFootprint>& obstacles,
+                            const GridLimits& limits, double cutoff_m);
+
 /// How much of a world's reachable free area the laser has seen, from the
 /// world's true geometry and the true laser poses: the explored fraction of
 /// summary.json and trajectory.csv.

@@ -11,6 +11,7 @@
 #include "common/grid2.h"
 #include "common/interrupt.h"
 #include "common/segments.h"
+#include "eval/ground_truth_detail.h"
 
 namespace mjslam::eval {
 
@@ -22,28 +23,7 @@ std::vector<ParamProblem> GroundTruthParams::Validate() const {
   return check.problems();
 }
 
-namespace {
-
-// A rectangle as centre, unit axes and half extents, corners counter-clockwise.
-struct Rectangle {
-  Eigen::Vector2d center;
-  Eigen::Vector2d u;  // unit axis along the first side
-  Eigen::Vector2d v;  // unit axis along the second side (u rotated +90 deg)
-  double half_u = 0.0;
-  double half_v = 0.0;
-  std::array<Eigen::Vector2d, 4> corners;  // counter-clockwise
-
-  // p in the rectangle's own coordinates.
-  Eigen::Vector2d Local(const Eigen::Vector2d& p) const {
-    const Eigen::Vector2d d = p - center;
-    return {d.dot(u), d.dot(v)};
-  }
-  // Inside the closed rectangle grown by `margin` on every side.
-  bool Contains(const Eigen::Vector2d& p, double margin) const {
-    const Eigen::Vector2d q = Local(p);
-    return std::abs(q.x()) <= half_u + margin && std::abs(q.y()) <= half_v + margin;
-  }
-};
+namespace detail {
 
 Rectangle MakeRectangle(const WallRectangle& wall, int index, double min_side) {
   const std::string name = "wall " + std::to_string(index);
@@ -79,8 +59,17 @@ Rectangle MakeRectangle(const WallRectangle& wall, int index, double min_side) {
   return r;
 }
 
-// Parameter interval [t0, t1] of the segment a + t d (t in [0, length]) inside
-// the rectangle grown by `margin` (slab clipping). False if none.
+AlignedBox2 BoundsOf(const Rectangle& r, double margin) {
+  AlignedBox2 box{r.corners[0], r.corners[0]};
+  for (const Eigen::Vector2d& c : r.corners) {
+    box.lo = box.lo.cwiseMin(c);
+    box.hi = box.hi.cwiseMax(c);
+  }
+  box.lo.array() -= margin;
+  box.hi.array() += margin;
+  return box;
+}
+
 bool ClipSegment(const Rectangle& r, const Eigen::Vector2d& a, const Eigen::Vector2d& d,
                  double length, double margin, double* t0, double* t1) {
   double lo = 0.0;
@@ -105,24 +94,20 @@ bool ClipSegment(const Rectangle& r, const Eigen::Vector2d& a, const Eigen::Vect
   return true;
 }
 
-// A straight piece of the union's boundary, traversed with the obstacle on
-// its left: from a to b, outward (free-side) normal n.
-struct Piece {
-  Eigen::Vector2d a;
-  Eigen::Vector2d b;
-  Eigen::Vector2d n;
-};
-
-// True when two pieces lie on one line facing the same way.
 bool SameLine(const Piece& p, const Piece& q, double tolerance) {
   if (p.n.dot(q.n) < 1.0 - 1e-9) return false;
   return std::abs(p.n.dot(q.a - p.a)) <= tolerance && std::abs(p.n.dot(q.b - p.a)) <= tolerance;
 }
 
-// The boundary pieces of the union, merged into maximal segments.
-std::vector<Piece> BoundarySegments(const std::vector<Rectangle>& rects,
-                                    const GroundTruthParams& params) {
+std::vector<Piece> BoundaryPieces(const std::vector<Rectangle>& rects,
+                                  const GroundTruthParams& params) {
   const double tol = params.touch_tolerance_m;
+  // Bounds grown beyond the clipping margin, so that every rectangle that can
+  // cut an edge or cover a point is a candidate of it.
+  std::vector<AlignedBox2> bounds;
+  bounds.reserve(rects.size());
+  for (const Rectangle& r : rects) bounds.push_back(BoundsOf(r, 2.0 * tol + 1e-9));
+  const BoxIndex index(bounds);
   std::vector<Piece> pieces;
   for (std::size_t i = 0; i < rects.size(); ++i) {
     ThrowIfInterrupted("ground truth");
@@ -134,8 +119,8 @@ std::vector<Piece> BoundarySegments(const std::vector<Rectangle>& rects,
       const Eigen::Vector2d n(d.y(), -d.x());  // right of d: outward for CCW
       // Split where the edge enters or leaves another (grown) rectangle.
       std::vector<double> cuts = {0.0, length};
-      for (std::size_t j = 0; j < rects.size(); ++j) {
-        if (j == i) continue;
+      for (const int j : index.Candidates(a.cwiseMin(b), a.cwiseMax(b))) {
+        if (j == static_cast<int>(i)) continue;
         double t0 = 0.0;
         double t1 = 0.0;
         if (ClipSegment(rects[j], a, d, length, tol, &t0, &t1)) {
@@ -150,54 +135,181 @@ std::vector<Piece> BoundarySegments(const std::vector<Rectangle>& rects,
         const Eigen::Vector2d mid = a + 0.5 * (cuts[k] + cuts[k + 1]) * d;
         const Eigen::Vector2d outside = mid + tol * n;
         bool covered = false;
-        for (std::size_t j = 0; j < rects.size() && !covered; ++j) {
-          covered = j != i && rects[j].Contains(outside, 0.0);
+        for (const int j : index.Candidates(outside)) {
+          covered = covered || (j != static_cast<int>(i) && rects[j].Contains(outside, 0.0));
         }
         if (!covered) pieces.push_back({a + cuts[k] * d, a + cuts[k + 1] * d, n});
       }
     }
   }
+  return pieces;
+}
 
-  // Merge pieces on one line that overlap or touch, until none do.
-  bool merged = true;
-  while (merged) {
-    ThrowIfInterrupted("ground truth");
-    merged = false;
-    for (std::size_t i = 0; i < pieces.size() && !merged; ++i) {
-      for (std::size_t j = i + 1; j < pieces.size() && !merged; ++j) {
-        if (!SameLine(pieces[i], pieces[j], tol)) continue;
-        const Eigen::Vector2d d(-pieces[i].n.y(), pieces[i].n.x());  // direction a -> b
-        const Eigen::Vector2d origin = pieces[i].a;
-        const double i0 = 0.0;
-        const double i1 = d.dot(pieces[i].b - origin);
-        const double j0 = d.dot(pieces[j].a - origin);
-        const double j1 = d.dot(pieces[j].b - origin);
-        if (j0 > i1 + 2.0 * tol || j1 < i0 - 2.0 * tol) continue;
-        const double lo = std::min(i0, j0);
-        const double hi = std::max(i1, j1);
-        pieces[i].a = (lo == i0) ? pieces[i].a : pieces[j].a;
-        pieces[i].b = (hi == i1) ? pieces[i].b : pieces[j].b;
-        pieces.erase(pieces.begin() + static_cast<std::ptrdiff_t>(j));
-        merged = true;
+namespace {
+
+// Union-find root of k, with path halving.
+int Root(std::vector<int>* parent, int k) {
+  while ((*parent)[k] != k) {
+    (*parent)[k] = (*parent)[(*parent)[k]];
+    k = (*parent)[k];
+  }
+  return k;
+}
+
+// Groups of pieces on one line (SameLine, joined transitively), each in
+// increasing order, the groups in order of their first piece. Candidates
+// come from a hash of the line's direction and offset: pieces on one line
+// differ by less than one bucket in each.
+std::vector<std::vector<int>> LineGroups(const std::vector<Piece>& pieces, double tol) {
+  const int n = static_cast<int>(pieces.size());
+  // SameLine admits normals 4.5e-5 rad apart; offsets n . a then differ by
+  // at most tol plus that angle times the distance from the origin.
+  constexpr double kAngleBucket = 1e-4;
+  const int num_angle_buckets = static_cast<int>(std::ceil(2.0 * M_PI / kAngleBucket));
+  double radius = 0.0;
+  for (const Piece& p : pieces) radius = std::max(radius, p.a.norm());
+  const double offset_bucket = 2.0 * (tol + 5e-5 * radius) + 1e-9;
+  std::vector<std::pair<long long, int>> keyed;
+  std::vector<std::pair<int, long long>> cells(n);
+  for (int k = 0; k < n; ++k) {
+    double angle = std::atan2(pieces[k].n.y(), pieces[k].n.x());
+    if (angle < 0.0) angle += 2.0 * M_PI;
+    const int ka = std::min(num_angle_buckets - 1, static_cast<int>(angle / kAngleBucket));
+    const long long ko = static_cast<long long>(std::floor(pieces[k].n.dot(pieces[k].a) /
+                                                           offset_bucket));
+    cells[k] = {ka, ko};
+    keyed.push_back({ko * num_angle_buckets + ka, k});
+  }
+  std::sort(keyed.begin(), keyed.end());
+  std::vector<int> parent(n);
+  for (int k = 0; k < n; ++k) parent[k] = k;
+  for (int i = 0; i < n; ++i) {
+    for (int da = -1; da <= 1; ++da) {
+      const int ka = (cells[i].first + da + num_angle_buckets) % num_angle_buckets;
+      for (long long ko = cells[i].second - 1; ko <= cells[i].second + 1; ++ko) {
+        const long long key = ko * num_angle_buckets + ka;
+        auto it = std::lower_bound(keyed.begin(), keyed.end(), std::make_pair(key, -1));
+        for (; it != keyed.end() && it->first == key; ++it) {
+          const int j = it->second;
+          if (j > i && SameLine(pieces[i], pieces[j], tol)) {
+            parent[Root(&parent, j)] = Root(&parent, i);
+          }
+        }
       }
     }
   }
+  std::vector<std::vector<int>> groups;
+  std::vector<int> group_of_root(n, -1);
+  for (int k = 0; k < n; ++k) {
+    const int root = Root(&parent, k);
+    if (group_of_root[root] < 0) {
+      group_of_root[root] = static_cast<int>(groups.size());
+      groups.emplace_back();
+    }
+    groups[group_of_root[root]].push_back(k);
+  }
+  return groups;
+}
+
+}  // namespace
+
+std::vector<Piece> MergeCollinear(std::vector<Piece> pieces, const GroundTruthParams& params) {
+  const double tol = params.touch_tolerance_m;
+  // Merged pieces by the index of their first piece.
+  std::vector<std::pair<int, Piece>> merged;
+  for (const std::vector<int>& group : LineGroups(pieces, tol)) {
+    // Positions along the line of the group's first piece, from its start.
+    const Piece& first = pieces[group.front()];
+    const Eigen::Vector2d d(-first.n.y(), first.n.x());  // direction a -> b
+    struct Span {
+      double s0;
+      double s1;
+      int index;
+    };
+    std::vector<Span> spans;
+    for (const int k : group) {
+      spans.push_back({d.dot(pieces[k].a - first.a), d.dot(pieces[k].b - first.a), k});
+    }
+    std::sort(spans.begin(), spans.end(), [](const Span& x, const Span& y) {
+      return x.s0 != y.s0 ? x.s0 < y.s0 : x.index < y.index;
+    });
+    // Sweep: a span joins the run when it starts within 2 tol of its end.
+    std::size_t k = 0;
+    while (k < spans.size()) {
+      Span start = spans[k];  // starts first (first index on ties)
+      Span end = spans[k];    // ends last (first index on ties)
+      int lowest = spans[k].index;
+      for (++k; k < spans.size() && spans[k].s0 <= end.s1 + 2.0 * tol; ++k) {
+        lowest = std::min(lowest, spans[k].index);
+        if (spans[k].s0 == start.s0 && spans[k].index < start.index) start = spans[k];
+        if (spans[k].s1 > end.s1 || (spans[k].s1 == end.s1 && spans[k].index < end.index)) {
+          end = spans[k];
+        }
+      }
+      merged.push_back({lowest, {pieces[start.index].a, pieces[end.index].b,
+                                 pieces[lowest].n}});
+    }
+  }
+  std::sort(merged.begin(), merged.end(),
+            [](const auto& x, const auto& y) { return x.first < y.first; });
   std::vector<Piece> segments;
-  for (const Piece& p : pieces) {
+  for (const auto& [index, p] : merged) {
     if ((p.b - p.a).norm() >= params.min_segment_length_m) segments.push_back(p);
   }
   return segments;
 }
 
-}  // namespace
+std::vector<int> NextSegments(const std::vector<Piece>& segments, double join_m) {
+  std::vector<AlignedBox2> starts;
+  starts.reserve(segments.size());
+  for (const Piece& s : segments) starts.push_back({s.a, s.a});
+  const BoxIndex index(starts);
+  std::vector<int> next(segments.size(), -1);
+  const Eigen::Vector2d reach = Eigen::Vector2d::Constant(join_m);
+  for (std::size_t i = 0; i < segments.size(); ++i) {
+    double best_distance = join_m;
+    for (const int j : index.Candidates(segments[i].b - reach, segments[i].b + reach)) {
+      if (j == static_cast<int>(i)) continue;
+      const double distance = (segments[j].a - segments[i].b).norm();
+      if (distance <= best_distance) {
+        next[i] = j;
+        best_distance = distance;
+      }
+    }
+  }
+  return next;
+}
+
+Grid2<std::uint8_t> OccupiedCells(const std::vector<Rectangle>& rects, const GridLimits& limits) {
+  Grid2<std::uint8_t> occupied(limits, 0);
+  for (const Rectangle& r : rects) {
+    // The cells whose centres may lie in the rectangle's bounds, one more
+    // each side for rounding.
+    const AlignedBox2 box = BoundsOf(r, 0.0);
+    const Eigen::Vector2i lo = limits.CellOf(box.lo);
+    const Eigen::Vector2i hi = limits.CellOf(box.hi);
+    for (int iy = std::max(0, lo.y() - 1); iy <= std::min(limits.height() - 1, hi.y() + 1);
+         ++iy) {
+      for (int ix = std::max(0, lo.x() - 1); ix <= std::min(limits.width() - 1, hi.x() + 1);
+           ++ix) {
+        if (!occupied(ix, iy) && r.Contains(limits.CellCenter(ix, iy), 0.0)) occupied(ix, iy) = 1;
+      }
+    }
+  }
+  return occupied;
+}
+
+}  // namespace detail
 
 Map BuildGroundTruthMap(const std::vector<WallRectangle>& walls, const GroundTruthParams& params) {
   params.ValidateOrThrow();
-  std::vector<Rectangle> rects;
+  std::vector<detail::Rectangle> rects;
   for (std::size_t i = 0; i < walls.size(); ++i) {
-    rects.push_back(MakeRectangle(walls[i], static_cast<int>(i), params.min_segment_length_m));
+    rects.push_back(
+        detail::MakeRectangle(walls[i], static_cast<int>(i), params.min_segment_length_m));
   }
-  std::vector<Piece> segments = BoundarySegments(rects, params);
+  std::vector<detail::Piece> segments =
+      detail::MergeCollinear(detail::BoundaryPieces(rects, params), params);
 
   // Corners: where a segment's end meets another's start at a real angle.
   // The split of a touching junction can leave the two a few tolerances
@@ -211,17 +323,9 @@ Map BuildGroundTruthMap(const std::vector<WallRectangle>& walls, const GroundTru
     int outgoing;
   };
   std::vector<Corner> corners;
+  const std::vector<int> next = detail::NextSegments(segments, join);
   for (std::size_t i = 0; i < segments.size(); ++i) {
-    int best = -1;
-    double best_distance = join;
-    for (std::size_t j = 0; j < segments.size(); ++j) {
-      if (j == i) continue;
-      const double distance = (segments[j].a - segments[i].b).norm();
-      if (distance <= best_distance) {
-        best = static_cast<int>(j);
-        best_distance = distance;
-      }
-    }
+    const int best = next[i];
     if (best < 0) continue;
     const Eigen::Vector2d d_in = (segments[i].b - segments[i].a).normalized();
     const Eigen::Vector2d d_out = (segments[best].b - segments[best].a).normalized();
@@ -240,7 +344,7 @@ Map BuildGroundTruthMap(const std::vector<WallRectangle>& walls, const GroundTru
   }
 
   Map map;
-  for (const Piece& s : segments) {
+  for (const detail::Piece& s : segments) {
     MapFeature line;
     line.id = static_cast<int>(map.size());
     line.type = MapFeature::Type::kLine;
@@ -275,15 +379,15 @@ Map ReachableFeatures(const Map& truth, const std::vector<WallRectangle>& walls,
     throw std::invalid_argument("reachable features: cell size must be > 0 (got " +
                                 ValueText(cell_m) + ")");
   }
-  std::vector<Rectangle> rects;
+  std::vector<detail::Rectangle> rects;
   for (std::size_t i = 0; i < walls.size(); ++i) {
-    rects.push_back(MakeRectangle(walls[i], static_cast<int>(i), 1e-9));
+    rects.push_back(detail::MakeRectangle(walls[i], static_cast<int>(i), 1e-9));
   }
   // The grid covers the walls, the start and the features, plus a margin
   // of two cells, so that the outside of a building is connected around it.
   Eigen::Vector2d lo = p_W_start;
   Eigen::Vector2d hi = p_W_start;
-  for (const Rectangle& r : rects) {
+  for (const detail::Rectangle& r : rects) {
     for (const Eigen::Vector2d& c : r.corners) {
       lo = lo.cwiseMin(c);
       hi = hi.cwiseMax(c);
@@ -294,13 +398,8 @@ Map ReachableFeatures(const Map& truth, const std::vector<WallRectangle>& walls,
   const GridLimits limits(lo, cell_m, static_cast<int>(std::ceil((hi.x() - lo.x()) / cell_m)),
                           static_cast<int>(std::ceil((hi.y() - lo.y()) / cell_m)));
   // A cell is free when its centre is in no wall.
-  auto free_cell = [&](int ix, int iy) {
-    const Eigen::Vector2d centre = limits.CellCenter(ix, iy);
-    for (const Rectangle& r : rects) {
-      if (r.Contains(centre, 0.0)) return false;
-    }
-    return true;
-  };
+  const Grid2<std::uint8_t> occupied = detail::OccupiedCells(rects, limits);
+  auto free_cell = [&](int ix, int iy) { return occupied(ix, iy) == 0; };
   const Eigen::Vector2i start = limits.CellOf(p_W_start);
   if (!free_cell(start.x(), start.y())) {
     throw std::invalid_argument("reachable features: the start point (" +

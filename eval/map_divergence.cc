@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "common/angles.h"
+#include "common/box_index.h"
 #include "common/check.h"
 #include "common/interrupt.h"
 
@@ -127,24 +128,52 @@ std::vector<double> LogPmf(const GaussianMixture& mixture,
     inverse[k] = {C(1, 1) / det, -C(0, 1) / det, C(0, 0) / det};
     log_scale[k] = std::log(mixture.weights[k]) - std::log(2.0 * kPi) - 0.5 * std::log(det);
   }
+  // Every term is at most max_log_scale - d^2 / (2 max_eigenvalue) at a
+  // distance d from its mean, so a point needs only the Gaussians near it:
+  // those in a square around it, grown until every Gaussian outside it is
+  // more than 40 (+1 for rounding) below the largest term inside. The terms
+  // kept are the same, summed in the same order, as over all Gaussians.
+  double max_log_scale = -std::numeric_limits<double>::infinity();
+  double max_eigenvalue = 0.0;
+  std::vector<AlignedBox2> at_means(num);
+  for (std::size_t k = 0; k < num; ++k) {
+    const Eigen::Matrix2d& C = mixture.covariances[k];
+    const double mid = 0.5 * (C(0, 0) + C(1, 1));
+    const double half_gap = std::hypot(0.5 * (C(0, 0) - C(1, 1)), C(0, 1));
+    max_eigenvalue = std::max(max_eigenvalue, mid + half_gap);
+    max_log_scale = std::max(max_log_scale, log_scale[k]);
+    at_means[k] = {mixture.means[k], mixture.means[k]};
+  }
+  const BoxIndex index(at_means);
+  const double first_radius = std::sqrt(2.0 * max_eigenvalue * 50.0);
   std::vector<double> log_density(points.size());
-  std::vector<double> terms(num);
+  std::vector<double> terms;
   for (std::size_t i = 0; i < points.size(); ++i) {
     // A stop request is noticed every 1024 points (well under a second).
     if (i % 1024 == 0) ThrowIfInterrupted("map divergence");
+    std::vector<int> near;
     double largest = -std::numeric_limits<double>::infinity();
-    for (std::size_t k = 0; k < num; ++k) {
-      const double dx = points[i].x() - mixture.means[k].x();
-      const double dy = points[i].y() - mixture.means[k].y();
-      const Eigen::Vector3d& w = inverse[k];
-      terms[k] = log_scale[k] - 0.5 * (w(0) * dx * dx + 2.0 * w(1) * dx * dy + w(2) * dy * dy);
-      largest = std::max(largest, terms[k]);
+    for (double radius = first_radius;; radius *= 2.0) {
+      const Eigen::Vector2d reach = Eigen::Vector2d::Constant(radius);
+      near = index.Candidates(points[i] - reach, points[i] + reach);
+      terms.resize(near.size());
+      largest = -std::numeric_limits<double>::infinity();
+      for (std::size_t m = 0; m < near.size(); ++m) {
+        const int k = near[m];
+        const double dx = points[i].x() - mixture.means[k].x();
+        const double dy = points[i].y() - mixture.means[k].y();
+        const Eigen::Vector3d& w = inverse[k];
+        terms[m] = log_scale[k] - 0.5 * (w(0) * dx * dx + 2.0 * w(1) * dx * dy + w(2) * dy * dy);
+        largest = std::max(largest, terms[m]);
+      }
+      const double outside = max_log_scale - 0.5 * radius * radius / max_eigenvalue + 1.0;
+      if (near.size() == num || (!near.empty() && outside <= largest - 40.0)) break;
     }
     // Terms more than 40 below the largest add less than 1e-17 of it.
     double sum = 0.0;
     const double cutoff = largest - 40.0;
-    for (std::size_t k = 0; k < num; ++k) {
-      if (terms[k] > cutoff) sum += std::exp(terms[k] - largest);
+    for (std::size_t m = 0; m < near.size(); ++m) {
+      if (terms[m] > cutoff) sum += std::exp(terms[m] - largest);
     }
     log_density[i] = largest + std::log(sum);
   }

@@ -7,6 +7,9 @@ tests/sim/worlds_test.cc checks the shipped files again, independently).
 
 Usage: python3 sim/tools/generate_worlds.py worlds
 Conventions of a world: worlds/README.md. Python 3 standard library only.
+The two office buildings (building_40x30.xml, building_80x50.xml) come from
+generate_building.py with the arguments in BUILDINGS below, and are checked
+by it.
 """
 import math
 import sys
@@ -26,6 +29,7 @@ class World:
         self.tour = []
         self.start = None
         self.extent = None
+        self.thickness = T  # wall thickness named in the file's comment
     def box(self, name, cx, cy, hx, hy, yaw_deg=0.0):
         self.boxes.append((name, cx, cy, hx, hy, yaw_deg))
     def wall(self, name, x0, y0, x1, y1, ext0=True, ext1=True, t=T):
@@ -83,7 +87,7 @@ class World:
         out.append(f'    <light name="sun" directional="true" pos="{fmt(fx)} {fmt(fy)} 8" dir="0 0 -1" diffuse="0.7 0.7 0.7"/>')
         out.append(f'    <geom name="floor" type="plane" pos="{fmt(fx)} {fmt(fy)} 0" size="{fmt(hx)} {fmt(hy)} 0.1" material="floor_mat"/>')
         out.append('')
-        out.append(f'    <!-- Walls: boxes {fmt(T)} m thick, {fmt(H)} m tall (yaw in degrees). -->')
+        out.append(f'    <!-- Walls: boxes {fmt(self.thickness)} m thick, {fmt(H)} m tall (yaw in degrees). -->')
         for (name, cx, cy, hx_, hy_, yaw) in self.boxes:
             e = f' euler="0 0 {fmt(yaw)}"' if abs(yaw) > 1e-9 else ''
             out.append(f'    <geom name="{name}" type="box" material="wall_mat" size="{fmt(hx_)} {fmt(hy_)} {fmt(H/2)}" pos="{fmt(cx)} {fmt(cy)} {fmt(H/2)}"{e}/>')
@@ -262,6 +266,16 @@ def pillars():
     w.extent = (-1.8, -1.3, 11.8, 9.8)
     return w
 
+# The shipped buildings: file stem and generate_building.py arguments.
+BUILDINGS = [
+    ("building_40x30", ["--seed", "1", "--size", "40x30", "--corridors", "2",
+                        "--cross-corridors", "2", "--door-width", "0.85", "--columns", "10",
+                        "--pillars", "6", "--free-walls", "6"]),
+    ("building_80x50", ["--seed", "2", "--size", "80x50", "--corridors", "4",
+                        "--cross-corridors", "5", "--door-width", "0.85", "--columns", "30",
+                        "--pillars", "15", "--free-walls", "15"]),
+]
+
 if __name__ == "__main__":
     if len(sys.argv) != 2:
         sys.exit("usage: generate_worlds.py OUTPUT_DIR")
@@ -270,3 +284,6 @@ if __name__ == "__main__":
         w = make()
         w.check()
         open(f"{outdir}/{w.name}.xml", "w").write(w.xml())
+    import generate_building
+    for stem, args in BUILDINGS:
+        generate_building.main(args + ["--out", f"{outdir}/{stem}.xml"])

@@ -1,5 +1,6 @@
 // The explored fraction from a world's true geometry.
 #include <cmath>
+#include <random>
 
 #include <gtest/gtest.h>
 
@@ -64,6 +65,43 @@ TEST(TrueCoverageTest, TheInsideOfTheClosedBoxDoesNotCount) {
   // Beams from inside the box see only the box's inside: nothing reachable.
   coverage.Observe(Pose2(2.0, 1.0, 0.0), FullCircle(0.45));
   EXPECT_EQ(coverage.ExploredFraction(), 0.0);
+}
+
+TEST(TrueCoverageTest, ClearanceGridIsExactUpToTheCutoff) {
+  // Boxes at random yaw and discs (seed 5), some overlapping, some long.
+  std::mt19937_64 rng(5);
+  std::uniform_real_distribution<double> position(-8.0, 8.0);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  std::vector<sim::ObstacleFootprint> obstacles;
+  for (int k = 0; k < 80; ++k) {
+    sim::ObstacleFootprint o;
+    o.X_WO = Pose2(position(rng), position(rng), 3.0 * position(rng));
+    if (k % 4 == 0) {
+      o.shape = sim::ObstacleFootprint::Shape::kCircle;
+      o.radius_m = 0.05 + 0.3 * unit(rng);
+    } else {
+      o.half_extents_m = Eigen::Vector2d(k % 9 == 0 ? 6.0 : 0.05 + unit(rng), 0.05 + 0.2 * unit(rng));
+    }
+    obstacles.push_back(o);
+  }
+  const GridLimits limits(Eigen::Vector2d(-10.0, -10.0), 0.1, 200, 200);
+  const double cutoff = 0.4;
+  const Grid2<double> clearance = ClearanceGrid(obstacles, limits, cutoff);
+  int wrong = 0;
+  int near = 0;
+  for (int j = 0; j < limits.height(); ++j) {
+    for (int i = 0; i < limits.width(); ++i) {
+      const double exact = sim::DistanceToObstacles(limits.CellCenter(i, j), obstacles);
+      if (exact <= cutoff) {
+        ++near;
+        wrong += clearance(i, j) != exact;
+      } else {
+        wrong += !(clearance(i, j) > cutoff);
+      }
+    }
+  }
+  EXPECT_EQ(wrong, 0);
+  EXPECT_GT(near, 1000);  // the test covers many cells near obstacles
 }
 
 }  // namespace

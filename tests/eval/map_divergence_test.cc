@@ -2,6 +2,8 @@
 #include "eval/map_divergence.h"
 
 #include <cmath>
+#include <limits>
+#include <random>
 
 #include <gtest/gtest.h>
 
@@ -208,6 +210,77 @@ TEST(MapDivergenceTest, BothFloorsRankAMapThreeMillimetresOffAboveOneOneMillimet
   EXPECT_LT(a[3].mean / a[2].mean, 11.0) << a[2].mean << " " << a[3].mean;
   EXPECT_GT(b[2].mean, 100.0 * a[2].mean) << b[2].mean;
   EXPECT_GT(b[3].mean, 1.2 * b[2].mean) << b[2].mean << " " << b[3].mean;
+}
+
+// The mixture's log PMF over every Gaussian (the direct sum, before the
+// Gaussians near each point were looked up in a grid).
+std::vector<double> DirectLogPmf(const GaussianMixture& mixture,
+                                 const std::vector<Eigen::Vector2d>& points) {
+  const std::size_t num = mixture.means.size();
+  std::vector<double> log_scale(num);
+  std::vector<Eigen::Vector3d> inverse(num);
+  for (std::size_t k = 0; k < num; ++k) {
+    const Eigen::Matrix2d& C = mixture.covariances[k];
+    const double det = C(0, 0) * C(1, 1) - C(0, 1) * C(1, 0);
+    inverse[k] = {C(1, 1) / det, -C(0, 1) / det, C(0, 0) / det};
+    log_scale[k] = std::log(mixture.weights[k]) - std::log(2.0 * kPi) - 0.5 * std::log(det);
+  }
+  std::vector<double> log_density(points.size());
+  std::vector<double> terms(num);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    double largest = -std::numeric_limits<double>::infinity();
+    for (std::size_t k = 0; k < num; ++k) {
+      const double dx = points[i].x() - mixture.means[k].x();
+      const double dy = points[i].y() - mixture.means[k].y();
+      const Eigen::Vector3d& w = inverse[k];
+      terms[k] = log_scale[k] - 0.5 * (w(0) * dx * dx + 2.0 * w(1) * dx * dy + w(2) * dy * dy);
+      largest = std::max(largest, terms[k]);
+    }
+    double sum = 0.0;
+    for (std::size_t k = 0; k < num; ++k) {
+      if (terms[k] > largest - 40.0) sum += std::exp(terms[k] - largest);
+    }
+    log_density[i] = largest + std::log(sum);
+  }
+  double largest = -std::numeric_limits<double>::infinity();
+  for (const double l : log_density) largest = std::max(largest, l);
+  double sum = 0.0;
+  for (const double l : log_density) sum += std::exp(l - largest);
+  for (double& l : log_density) l -= largest + std::log(sum);
+  return log_density;
+}
+
+TEST(MapDivergenceTest, LogPmfEqualsTheDirectSumOverEveryGaussian) {
+  // Gaussians of very different sizes and weights, clustered and spread,
+  // and points near them, between them and far outside (seed 11).
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> position(-20.0, 20.0);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  GaussianMixture mixture;
+  for (int k = 0; k < 400; ++k) {
+    const double scale = k % 50 == 0 ? 0.2 : 0.02;
+    const Eigen::Vector2d mean = k % 3 == 0 ? Eigen::Vector2d(position(rng), position(rng))
+                                            : Eigen::Vector2d(0.1 * position(rng), 1.0);
+    Eigen::Matrix2d A;
+    A << scale * (0.2 + unit(rng)), scale * unit(rng), 0.0, scale * (0.2 + unit(rng));
+    mixture.means.push_back(mean);
+    mixture.covariances.push_back(A * A.transpose());
+    mixture.weights.push_back(0.5 + unit(rng));
+  }
+  double total = 0.0;
+  for (const double w : mixture.weights) total += w;
+  for (double& w : mixture.weights) w /= total;
+  std::vector<Eigen::Vector2d> points;
+  for (int i = 0; i < 3000; ++i) {
+    points.emplace_back(3.0 * position(rng), i % 2 == 0 ? 1.0 + 0.01 * position(rng)
+                                                          : 3.0 * position(rng));
+  }
+  const std::vector<double> fast = LogPmf(mixture, points);
+  const std::vector<double> direct = DirectLogPmf(mixture, points);
+  ASSERT_EQ(fast.size(), direct.size());
+  int differ = 0;
+  for (std::size_t i = 0; i < fast.size(); ++i) differ += fast[i] != direct[i];
+  EXPECT_EQ(differ, 0);
 }
 
 }  // namespace
