@@ -39,11 +39,14 @@ std::string Output(const std::string& command) {
   return text;
 }
 
-// Room tours of 40 s: long enough that a cancelled task is still running.
+// Room tours of 600 s (about 3 s of CPU each): long enough that a task seen
+// running is still running when it is cancelled (50 ms later at most). Tours
+// of 40 s took 0.3 s once the laser and contacts became local, and a task
+// could finish between squeue and scancel.
 app::RunConfig Config() {
   return app::LoadRunConfig(DefaultConfig(),
                             {"run.world=" + std::string(MJSLAM_SOURCE_DIR) + "/worlds/room.xml",
-                             "control.driver=tour", "render.enabled=false", "run.duration_s=40",
+                             "control.driver=tour", "render.enabled=false", "run.duration_s=600",
                              "run.seed=7"});
 }
 
