@@ -1,10 +1,11 @@
 #!/usr/bin/python3
-"""Calibrates the filters' process noise from the true motion of runs: the
-values of slam.ekf.command_noise.*, slam.ekf.odometry_noise.*,
+"""Calibrates the filters' process model from the true motion of runs: the
+values of slam.ekf.command_gain_v, _w, slam.ekf.command_noise.*, slam.ekf.odometry_noise.*,
 slam.ekf.lateral_skid_s and slam.ekf.lateral_slip_std_m_per_rad
 (docs/method.md, "Calibrating the process noise").
 
-    scripts/calibrate_noise.py DIR [DIR ...] [--offset A] [--window L] [--json FILE]
+    scripts/calibrate_noise.py DIR [DIR ...] [--offset A] [--window L] [--no-gain] [--no-lag]
+                               [--json FILE]
 
 Each DIR is a run directory (with trajectory.csv) or a sweep directory (its
 runs/run_*/ are taken). For every step k of a trajectory (rows k-1 and k,
@@ -14,13 +15,25 @@ is given with what the robot did, the axle centre A metres behind R
 an arc along the mid-arc heading, plus a sideways skid):
 
 - command: the filter predicts step k with the command of row k-1 held over
-  dt, its noise growing with the change from the command of row k-2. The
-  errors e_v = d / dt - v and e_w = dth / dt - w of the true increment (d,
-  dth) are modelled as independent zero-mean Gaussians with
-      sigma_v = v_noise_std_mps + v_noise_fraction |v| + change_noise_fraction |v - v_prev|
-      sigma_w = w_noise_std_radps + w_noise_fraction |w| + change_noise_fraction |w - w_prev|
-  (slam/motion_model.h, CommandInput), and the five constants are fitted by
-  maximum likelihood. The wheels' lag makes successive errors alike, which
+  dt, passed through the wheels' first-order lag (slam.ekf.command_lag_s,
+  the time constant tau; FollowCommand in slam/motion_model.h: the speeds
+  followed move toward the command by 1 - exp(-dt / tau) a step, from rest
+  at the start; tau fitted first, by the least squared speed errors, with
+  the gains by least squares at each tau; --no-lag keeps tau 0) and scaled
+  by the gains g_v and g_w (slam.ekf.command_gain_v, _w: the
+  robot's mean speed over its command), its noise growing with the change
+  from the command of row k-2. The errors e_v = d / dt - g_v v_f and
+  e_w = dth / dt - g_w w_f (v_f, w_f the speeds followed) of the true increment (d, dth) are modelled as
+  independent zero-mean Gaussians with
+      sigma_v = v_noise_std_mps + v_noise_fraction |v_f| + change_noise_fraction |v - v_prev|
+      sigma_w = w_noise_std_radps + w_noise_fraction |w_f| + change_noise_fraction |w - w_prev|
+  (slam/motion_model.h, CommandInput); the five constants and the two gains
+  are fitted by maximum likelihood (alternately: the gains by weighted least
+  squares with the sigmas fixed, the sigmas by Nelder-Mead with the gains
+  fixed). --no-gain keeps the gains at 1 (the paper's model). The gains of
+  each run on its own are printed too: a spread between runs larger than
+  their standard errors is a bias that changes from run to run, which a
+  constant gain cannot remove. The wheels' lag makes successive errors alike, which
   a filter that takes them as independent underrates; --window L fits the
   errors of the increments summed over L steps instead (their variance the
   sum of the steps' variances, as the filter adds them), so that the noise
@@ -171,13 +184,90 @@ def gaussian_nll(errors_and_variances):
 
 def command_sigmas(s, p):
     """(sigma_v, sigma_w) of CommandInput for step s, p = (v0, kv, w0, kw, kc)."""
-    v0, kv, w0, kw, kc = p
-    return (v0 + kv * abs(s["v"]) + kc * s["dv"], w0 + kw * abs(s["w"]) + kc * s["dw"])
+    v0, kv, w0, kw, kc = p[:5]
+    return (v0 + kv * abs(s["fv"]) + kc * s["dv"], w0 + kw * abs(s["fw"]) + kc * s["dw"])
 
 
-def command_errors(s):
-    """(e_v, e_w): the true speeds over the step less the command held."""
-    return (s["d"] / s["dt"] - s["v"], s["dth"] / s["dt"] - s["w"])
+def command_errors(s, gains=(1.0, 1.0)):
+    """(e_v, e_w): the true speeds over the step less the speeds the model
+    follows the command with (apply_lag), times the gains (g_v, g_w)."""
+    return (s["d"] / s["dt"] - gains[0] * s["fv"], s["dth"] / s["dt"] - gains[1] * s["fw"])
+
+
+def apply_lag(runs_steps, lag):
+    """Sets each step's followed speeds (fv, fw): the commands through a
+    first-order lag of time constant `lag` seconds, from rest at a run's
+    first step, as slam::FollowCommand (lag 0: the commands)."""
+    for steps in runs_steps:
+        fv = fw = 0.0
+        for s in steps:
+            beta = 1.0 if lag <= 0.0 else -math.expm1(-s["dt"] / lag)
+            fv += beta * (s["v"] - fv)
+            fw += beta * (s["w"] - fw)
+            s["fv"], s["fw"] = fv, fw
+
+
+def lag_cost(runs_steps, lag):
+    """log(mean e_v^2) + log(mean e_w^2) with the lag and the least-squares
+    gains: the Gaussian likelihood's cost with constant variances."""
+    apply_lag(runs_steps, lag)
+    steps = [s for run_steps in runs_steps for s in run_steps]
+    cost = 0.0
+    for speed, followed in (("d", "fv"), ("dth", "fw")):
+        sxx = sum(s[followed] ** 2 for s in steps)
+        gain = sum(s[followed] * s[speed] / s["dt"] for s in steps) / sxx if sxx > 0 else 1.0
+        mse = sum((s[speed] / s["dt"] - gain * s[followed]) ** 2 for s in steps) / len(steps)
+        cost += math.log(max(mse, 1e-300))
+    return cost
+
+
+def fit_lag(runs_steps, longest=0.5):
+    """The lag time constant in [0, longest] s that minimises lag_cost
+    (golden-section search; 0 if no lag fits better)."""
+    lo, hi = 0.0, longest
+    ratio = (math.sqrt(5.0) - 1.0) / 2.0
+    a, b = hi - ratio * (hi - lo), lo + ratio * (hi - lo)
+    fa, fb = lag_cost(runs_steps, a), lag_cost(runs_steps, b)
+    while hi - lo > 1e-4:
+        if fa < fb:
+            hi, b, fb = b, a, fa
+            a = hi - ratio * (hi - lo)
+            fa = lag_cost(runs_steps, a)
+        else:
+            lo, a, fa = a, b, fb
+            b = lo + ratio * (hi - lo)
+            fb = lag_cost(runs_steps, b)
+    best = 0.5 * (lo + hi)
+    return best if lag_cost(runs_steps, best) < lag_cost(runs_steps, 0.0) else 0.0
+
+
+def fit_gains(steps, p):
+    """(g_v, g_w, se_v, se_w): the gains by weighted least squares of the true
+    speeds on the commands, weights 1 / sigma^2 of the noise p, and their
+    standard errors from the scatter of the weighted residuals."""
+    result = []
+    for speed, command, index in (("d", "fv", 0), ("dth", "fw", 1)):
+        sxx = sxy = 0.0
+        for s in steps:
+            weight = 1.0 / command_sigmas(s, p)[index] ** 2
+            sxx += weight * s[command] ** 2
+            sxy += weight * s[command] * s[speed] / s["dt"]
+        if sxx == 0.0:
+            result.append(1.0)
+            continue
+        result.append(sxy / sxx)
+    chi2 = [0.0, 0.0]
+    sxx = [0.0, 0.0]
+    for s in steps:
+        errors = command_errors(s, result)
+        sigmas = command_sigmas(s, p)
+        for i, command in enumerate(("fv", "fw")):
+            chi2[i] += (errors[i] / sigmas[i]) ** 2
+            sxx[i] += (s[command] / sigmas[i]) ** 2
+    n = max(len(steps) - 1, 1)
+    return (result[0], result[1],
+            math.sqrt(chi2[0] / n / sxx[0]) if sxx[0] > 0 else math.inf,
+            math.sqrt(chi2[1] / n / sxx[1]) if sxx[1] > 0 else math.inf)
 
 
 def windows_of(runs_steps, window):
@@ -190,16 +280,16 @@ def windows_of(runs_steps, window):
     return out
 
 
-def window_pairs(windows, p):
+def window_pairs(windows, p, gains=(1.0, 1.0)):
     """(error, variance) of the increments summed over each window: the true
-    distance and turn less the commanded ones, against the sum of the
-    per-step variances the filter adds (dt sigma)^2."""
+    distance and turn less the commanded ones (times the gains), against the
+    sum of the per-step variances the filter adds (dt sigma)^2."""
     pairs = []
     for window in windows:
         ed = eth = vd = vth = 0.0
         for s in window:
             sv, sw = command_sigmas(s, p)
-            ev, ew = command_errors(s)
+            ev, ew = command_errors(s, gains)
             ed += ev * s["dt"]
             eth += ew * s["dt"]
             vd += (sv * s["dt"]) ** 2
@@ -209,20 +299,30 @@ def window_pairs(windows, p):
     return pairs
 
 
-def fit_command(runs_steps, window):
-    """CommandNoiseParams by maximum likelihood of the increments' errors
-    summed over windows of `window` steps (1: every step on its own)."""
+def fit_command(runs_steps, window, with_gains=True, rounds=3):
+    """(CommandNoiseParams, (g_v, g_w, se_v, se_w)) by maximum likelihood of
+    the increments' errors summed over windows of `window` steps (1: every
+    step on its own); the gains 1 when not `with_gains`."""
     windows = windows_of(runs_steps, window)
-    return fit(lambda p: gaussian_nll(window_pairs(windows, p)), [0.01, 0.05, 0.01, 0.05, 0.3])
+    steps = [s for run_steps in runs_steps for s in run_steps]
+    gains = (1.0, 1.0, 0.0, 0.0)
+    p = [0.01, 0.05, 0.01, 0.05, 0.3]
+    for _ in range(rounds if with_gains else 1):
+        p = fit(lambda q: gaussian_nll(window_pairs(windows, q, gains[:2])), p)
+        if with_gains:
+            gains = fit_gains(steps, p)
+    if with_gains:
+        p = fit(lambda q: gaussian_nll(window_pairs(windows, q, gains[:2])), p)
+    return p, gains
 
 
-def variance_ratios(runs_steps, p, lengths):
+def variance_ratios(runs_steps, p, lengths, gains=(1.0, 1.0)):
     """For each window length: sum of the squared summed errors over the sum
     of the model's summed variances, distance and turn (1 when the errors of
     successive steps are independent and the model fits)."""
     ratios = []
     for length in lengths:
-        pairs = window_pairs(windows_of(runs_steps, length), p)
+        pairs = window_pairs(windows_of(runs_steps, length), p, gains)
         d = pairs[0::2]
         th = pairs[1::2]
         ratios.append((length, sum(e * e for e, _ in d) / sum(v for _, v in d),
@@ -284,6 +384,10 @@ def main():
     parser.add_argument("--window", type=int, default=1,
                         help="fit the command noise to the errors summed over windows of this "
                              "many steps (default 1: each step on its own)")
+    parser.add_argument("--no-gain", action="store_true",
+                        help="keep the command gains at 1 (fit the noise only)")
+    parser.add_argument("--no-lag", action="store_true",
+                        help="no lag of the wheels behind the command (command_lag_s 0)")
     parser.add_argument("--json", help="also write the fitted values to this JSON file")
     args = parser.parse_args()
 
@@ -301,11 +405,16 @@ def main():
         print(f"calibrate_noise: --window: expected an integer >= 1 (got {args.window})",
               file=sys.stderr)
         return 2
-    command = fit_command(runs_steps, args.window)
+    lag = 0.0 if args.no_lag else fit_lag(runs_steps)
+    apply_lag(runs_steps, lag)
+    command, gains = fit_command(runs_steps, args.window, not args.no_gain)
     odometry = fit_odometry(steps)
 
     print(f"# scripts/calibrate_noise.py: {len(steps)} steps from {len(runs)} runs")
     print("slam:\n  ekf:")
+    print(f"    command_gain_v: {gains[0]:.6g}   # standard error {gains[2]:.2g}")
+    print(f"    command_gain_w: {gains[1]:.6g}   # standard error {gains[3]:.2g}")
+    print(f"    command_lag_s: {lag:.4g}")
     names = ["v_noise_std_mps", "v_noise_fraction", "w_noise_std_radps", "w_noise_fraction",
              "change_noise_fraction"]
     print("    command_noise:")
@@ -323,15 +432,26 @@ def main():
     print(f"# command noise fitted to errors summed over {args.window} step(s)")
     print("# summed errors over windows of L steps: mean e^2 / model variance, distance and turn")
     print("# (1 where the fit holds at that time scale; growing with L: errors persist)")
-    for length, rd, rth in variance_ratios(runs_steps, command, [1, 2, 5, 10, 20, 50, 100]):
+    for length, rd, rth in variance_ratios(runs_steps, command, [1, 2, 5, 10, 20, 50, 100],
+                                           gains[:2]):
         print(f"#   L = {length:3d}: {rd:6.2f} {rth:6.2f}")
+    if not args.no_gain:
+        print("# gains of each run on its own (weighted least squares, the noise above):")
+        per_run = [fit_gains(run_steps, command) for run_steps in runs_steps if run_steps]
+        for name, index, se in (("v", 0, 2), ("w", 1, 3)):
+            values = [g[index] for g in per_run]
+            mean = sum(values) / len(values)
+            spread = math.sqrt(sum((x - mean) ** 2 for x in values) / max(len(values) - 1, 1))
+            typical_se = math.sqrt(sum(g[se] ** 2 for g in per_run) / len(per_run))
+            print(f"#   g_{name}: mean {mean:.6f}, spread between runs {spread:.2e}, "
+                  f"a run's standard error {typical_se:.2e}")
     print("# fit: mean (error / sigma)^2 by bin (1 where the model fits)")
 
     def nv(s):
-        return (command_errors(s)[0] / command_sigmas(s, command)[0]) ** 2
+        return (command_errors(s, gains)[0] / command_sigmas(s, command)[0]) ** 2
 
     def nw(s):
-        return (command_errors(s)[1] / command_sigmas(s, command)[1]) ** 2
+        return (command_errors(s, gains)[1] / command_sigmas(s, command)[1]) ** 2
 
     for s in steps:
         s["|v|"], s["|w|"] = abs(s["v"]), abs(s["w"])
@@ -353,6 +473,7 @@ def main():
 
     if args.json:
         values = {"steps": len(steps), "runs": len(runs),
+                  "command_gain_v": gains[0], "command_gain_w": gains[1], "command_lag_s": lag,
                   "command_noise": dict(zip(names, command)),
                   "odometry_noise": dict(zip(odometry_names, odometry)),
                   "lateral_skid_s": c, "lateral_slip_std_m_per_rad": k}

@@ -69,7 +69,7 @@ EkfSlam::EkfSlam(const EkfParams& params, CorrectionMode mode, const Pose2& X_WR
                              params.initial_position_std_m * params.initial_position_std_m,
                              params.initial_heading_std_rad * params.initial_heading_std_rad)
                  .asDiagonal(),
-             X_RS),
+             X_RS, JacobianPointFromName(params.jacobians)),
       gate_(ChiSquare2Quantile(params.gate_probability)),
       new_feature_threshold_(ChiSquare2Quantile(params.new_feature_probability)) {
   if (!IsFinite(X_WR0)) {
@@ -217,7 +217,10 @@ MotionInput EkfSlam::CheckedMotionInput(const SensorRecord& record) const {
   } else {
     RequireFinite(record.command.v_mps, "record.command.v_mps");
     RequireFinite(record.command.w_radps, "record.command.w_radps");
-    input = CommandInput(record.command, record.dt_s, params_.command_noise, previous_command_);
+    const Twist2 followed =
+        FollowCommand(followed_command_, record.command, record.dt_s, params_.command_lag_s);
+    input = CommandInput(record.command, record.dt_s, params_.command_noise, previous_command_,
+                         params_.command_gain_v, params_.command_gain_w, &followed);
   }
   const double slip_std = params_.lateral_slip_std_m_per_rad * std::abs(input.increment.y());
   input.lateral_variance_m2 = slip_std * slip_std;
@@ -231,6 +234,8 @@ void EkfSlam::Predict(const SensorRecord& record, const MotionInput& input) {
     X_OR_previous_ = record.X_OR;
     has_odometry_ = true;
   }
+  followed_command_ =
+      FollowCommand(followed_command_, record.command, record.dt_s, params_.command_lag_s);
   previous_command_ = record.command;
   state_.Predict(input, params_.control_point_offset_m);
 }

@@ -99,14 +99,24 @@ Eigen::Vector3d PredictPose(const Eigen::Vector3d& pose_WR, const Eigen::Vector2
   return ApplyStep(pose_WR, dth, step, A, W);
 }
 
+Twist2 FollowCommand(const Twist2& followed, const Twist2& command, double dt_s, double lag_s) {
+  if (lag_s <= 0.0) return command;
+  const double beta = -std::expm1(-dt_s / lag_s);  // 1 - exp(-dt / lag), exact for small dt
+  return Twist2{followed.v_mps + beta * (command.v_mps - followed.v_mps),
+                followed.w_radps + beta * (command.w_radps - followed.w_radps)};
+}
+
 MotionInput CommandInput(const Twist2& command, double dt_s, const CommandNoiseParams& noise,
-                         const Twist2& previous) {
+                         const Twist2& previous, double gain_v, double gain_w,
+                         const Twist2* followed) {
+  const Twist2& speeds = followed != nullptr ? *followed : command;
   MotionInput input;
-  input.increment = Eigen::Vector2d(command.v_mps * dt_s, command.w_radps * dt_s);
-  const double sigma_v = noise.v_noise_std_mps + noise.v_noise_fraction * std::abs(command.v_mps) +
+  input.increment =
+      Eigen::Vector2d(gain_v * speeds.v_mps * dt_s, gain_w * speeds.w_radps * dt_s);
+  const double sigma_v = noise.v_noise_std_mps + noise.v_noise_fraction * std::abs(speeds.v_mps) +
                          noise.change_noise_fraction * std::abs(command.v_mps - previous.v_mps);
   const double sigma_w =
-      noise.w_noise_std_radps + noise.w_noise_fraction * std::abs(command.w_radps) +
+      noise.w_noise_std_radps + noise.w_noise_fraction * std::abs(speeds.w_radps) +
       noise.change_noise_fraction * std::abs(command.w_radps - previous.w_radps);
   input.covariance = Eigen::Vector2d(dt_s * dt_s * sigma_v * sigma_v,
                                      dt_s * dt_s * sigma_w * sigma_w)

@@ -45,13 +45,25 @@ Eigen::Vector3d PredictPose(const Eigen::Vector3d& pose_WR, const Eigen::Vector2
                             double skid_per_m_rad = 0.0,
                             MotionIntegration integration = MotionIntegration::kExact);
 
-/// The command held over `dt_s` (>= 0) as an input: increment (v dt, w dt),
-/// covariance diag((dt sigma_v)^2, (dt sigma_w)^2) with
+/// The speeds the robot moves at over a step of `dt_s` (>= 0) when it
+/// follows `command` through a first-order lag of time constant `lag_s`
+/// (>= 0), having moved at `followed` over the step before:
+///   followed + (1 - exp(-dt / lag)) (command - followed),
+/// both components (the wheels' lag acts on v and w alike). `lag_s` = 0:
+/// the command itself (EkfParams::command_lag_s).
+Twist2 FollowCommand(const Twist2& followed, const Twist2& command, double dt_s, double lag_s);
+
+/// The command held over `dt_s` (>= 0) as an input: increment (g_v v dt,
+/// g_w w dt) of the speeds (v, w) the robot moves at, `*followed` when not
+/// null (FollowCommand) else `command`, with the gains `gain_v`, `gain_w`
+/// (EkfParams::command_gain_v, _w: the mean ratio of the robot's true speeds
+/// to its commands); covariance diag((dt sigma_v)^2, (dt sigma_w)^2) with
 ///   sigma_v = v_noise_std_mps + v_noise_fraction |v|
-///             + change_noise_fraction |v - previous.v|   (likewise w),
+///             + change_noise_fraction |command.v - previous.v|   (likewise w),
 /// `previous` being the command of the record before (CommandNoiseParams).
 MotionInput CommandInput(const Twist2& command, double dt_s, const CommandNoiseParams& noise,
-                         const Twist2& previous);
+                         const Twist2& previous, double gain_v = 1.0, double gain_w = 1.0,
+                         const Twist2* followed = nullptr);
 
 /// The wheel-odometry increment between two records as the equivalent input:
 /// the (d, dth) that PredictPose with offset `a_m` turns into the motion

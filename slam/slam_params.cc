@@ -26,6 +26,10 @@ MotionIntegration MotionIntegrationFromName(const std::string& name) {
       IndexOfName(kMotionIntegrationNames, name, "motion_integration"));
 }
 
+JacobianPoint JacobianPointFromName(const std::string& name) {
+  return static_cast<JacobianPoint>(IndexOfName(kJacobianPointNames, name, "jacobians"));
+}
+
 SelectionPolicy SelectionPolicyFromName(const std::string& name) {
   return static_cast<SelectionPolicy>(
       IndexOfName(kSelectionPolicyNames, name, "selection_policy"));
@@ -63,10 +67,19 @@ std::vector<ParamProblem> EkfParams::Validate() const {
   check.Positive("control_point_offset_m", control_point_offset_m);
   check.Require(std::isfinite(control_point_offset_m), "control_point_offset_m",
                 control_point_offset_m, "a finite value");
+  check.Positive("command_gain_v", command_gain_v);
+  check.Require(std::isfinite(command_gain_v), "command_gain_v", command_gain_v, "a finite value");
+  check.Positive("command_gain_w", command_gain_w);
+  check.Require(std::isfinite(command_gain_w), "command_gain_w", command_gain_w, "a finite value");
+  check.NonNegative("command_lag_s", command_lag_s);
+  check.Require(std::isfinite(command_lag_s), "command_lag_s", command_lag_s, "a finite value");
   check.Merge("command_noise", command_noise.Validate());
   check.Merge("odometry_noise", odometry_noise.Validate());
   check.NonNegative("lateral_slip_std_m_per_rad", lateral_slip_std_m_per_rad);
   check.NonNegative("lateral_skid_s", lateral_skid_s);
+  check.OneOf("jacobians", jacobians,
+              std::vector<std::string>(std::begin(kJacobianPointNames),
+                                       std::end(kJacobianPointNames)));
   check.NonNegative("initial_position_std_m", initial_position_std_m);
   check.NonNegative("initial_heading_std_rad", initial_heading_std_rad);
   check.NonNegative("extra_line_rho_std_m", extra_line_rho_std_m);

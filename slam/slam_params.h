@@ -34,8 +34,23 @@ enum class SelectionPolicy {
   kDeterminant,
 };
 
+/// Where the filter evaluates the Jacobians of the prediction and of the
+/// observations (`slam.ekf.jacobians`; docs/method.md, departure 20).
+enum class JacobianPoint {
+  /// At the current estimate, as the standard EKF (the paper's).
+  kCurrent,
+  /// First-estimates Jacobians (FEJ-EKF; Huang, Mourikis and Roumeliotis,
+  /// IJRR 29(5), 2010): every feature at its first estimate, the pose of a
+  /// step at its predicted (prior) estimate, in the prediction and in every
+  /// correction of that step, so that the linearised model keeps the
+  /// unobservable global translation and rotation unobservable.
+  kFirstEstimates,
+};
+
 /// The names the YAML uses, in enum order.
 inline constexpr const char* kMotionIntegrationNames[] = {"exact", "euler"};
+/// The names the YAML uses, in enum order.
+inline constexpr const char* kJacobianPointNames[] = {"current", "first_estimates"};
 /// The names the YAML uses, in enum order.
 inline constexpr const char* kSelectionPolicyNames[] = {"criterion", "first", "random",
                                                         "least_informative", "determinant"};
@@ -43,6 +58,9 @@ inline constexpr const char* kSelectionPolicyNames[] = {"criterion", "first", "r
 /// The enum of a `slam.ekf.motion_integration` value. Throws ParamError for
 /// a name not in kMotionIntegrationNames.
 MotionIntegration MotionIntegrationFromName(const std::string& name);
+/// The enum of a `slam.ekf.jacobians` value. Throws ParamError for a name not
+/// in kJacobianPointNames.
+JacobianPoint JacobianPointFromName(const std::string& name);
 /// The enum of a `slam.ekf.selection_policy` value. Throws ParamError for a
 /// name not in kSelectionPolicyNames.
 SelectionPolicy SelectionPolicyFromName(const std::string& name);
@@ -134,6 +152,21 @@ struct EkfParams {
   /// Offset `a` of the point of control h (frame R) ahead of the wheel axle,
   /// metres (> 0). Must match the robot's (`robot.control_point_offset_m`).
   double control_point_offset_m = 0.2;
+  /// Systematic part of the command following, `input: command` only: the
+  /// prediction moves by (command_gain_v v dt, command_gain_w w dt) for the
+  /// command (v, w) held over dt (the noise stays that of the command). The
+  /// mean ratio of the robot's true speeds to its commands, identified by
+  /// scripts/calibrate_noise.py (docs/method.md, "Calibrating the process
+  /// noise"). 1: the command as it is (the paper's).
+  double command_gain_v = 1.0;
+  /// Same for the turn rate.
+  double command_gain_w = 1.0;
+  /// Time constant of the wheels' first-order lag behind the command,
+  /// seconds (>= 0), `input: command` only: the prediction moves at the
+  /// speeds FollowCommand gives (the robot starts at rest), not at the
+  /// command held. Identified by scripts/calibrate_noise.py. 0: the command
+  /// held over the step (the paper's).
+  double command_lag_s = 0.0;
   /// Input noise when `input` is "command".
   CommandNoiseParams command_noise;
   /// Input noise when `input` is "odometry".
@@ -151,6 +184,11 @@ struct EkfParams {
   /// the paper. The default is the simulated Pioneer's, measured from the
   /// true motion (docs/method.md, departure 13).
   double lateral_skid_s = 0.0102;
+
+  /// Where the Jacobians are evaluated: "current" (the standard EKF, the
+  /// paper's) or "first_estimates" (FEJ-EKF, docs/method.md departure 20).
+  /// Read as JacobianPoint.
+  std::string jacobians = "current";
 
   /// Standard deviation of the initial position of R, metres (0: known start,
   /// as in the paper).
@@ -222,10 +260,14 @@ struct EkfParams {
     a->Visit(MJSLAM_NVP(input));
     a->Visit(MJSLAM_NVP(motion_integration));
     a->Visit(MJSLAM_NVP(control_point_offset_m));
+    a->Visit(MJSLAM_NVP(command_gain_v));
+    a->Visit(MJSLAM_NVP(command_gain_w));
+    a->Visit(MJSLAM_NVP(command_lag_s));
     a->Visit(MJSLAM_NVP(command_noise));
     a->Visit(MJSLAM_NVP(odometry_noise));
     a->Visit(MJSLAM_NVP(lateral_slip_std_m_per_rad));
     a->Visit(MJSLAM_NVP(lateral_skid_s));
+    a->Visit(MJSLAM_NVP(jacobians));
     a->Visit(MJSLAM_NVP(initial_position_std_m));
     a->Visit(MJSLAM_NVP(initial_heading_std_rad));
     a->Visit(MJSLAM_NVP(extra_line_rho_std_m));

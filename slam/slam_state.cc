@@ -25,9 +25,10 @@ constexpr double kMinCornerRange = 1e-9;
 }  // namespace
 
 SlamState::SlamState(const Eigen::Vector3d& pose_WR, const Eigen::Matrix3d& pose_covariance,
-                     const Pose2& X_RS)
-    : X_RS_(X_RS), x_(pose_WR) {
+                     const Pose2& X_RS, JacobianPoint jacobians)
+    : X_RS_(X_RS), x_(pose_WR), jacobians_(jacobians) {
   x_.z() = WrapAngleFast(x_.z());
+  if (jacobians_ == JacobianPoint::kFirstEstimates) x_first_ = x_;
   const int capacity = PaddedSize(3 + 2 * kInitialFeatureCapacity);
   P_ = Eigen::MatrixXd::Zero(capacity, capacity);
   P_.topLeftCorner<3, 3>() = 0.5 * (pose_covariance + pose_covariance.transpose());
@@ -49,6 +50,15 @@ void SlamState::Predict(const MotionInput& input, double a_m) {
   Eigen::Matrix<double, 3, 2> W;
   x_.head<3>() = PredictPose(x_.head<3>(), input.increment, a_m, &A, &W, input.skid_per_m_rad,
                              input.integration);
+  if (jacobians_ == JacobianPoint::kFirstEstimates) {
+    // FEJ (Huang et al. 2010): A = d pose' / d pose is the identity but for
+    // the heading column, the displacement rotated by 90 deg; take the
+    // displacement from the previous predicted pose to the new one, so that
+    // the propagations chain through the same poses as the observations.
+    A(0, 2) = -(x_.y() - x_first_.y());
+    A(1, 2) = x_.x() - x_first_.x();
+    x_first_.head<3>() = x_.head<3>();
+  }
 
   // Pose block: A P_pp A^T + W Q W^T, symmetrised exactly.
   const Eigen::Matrix3d P_pp = P_.topLeftCorner<3, 3>();
@@ -74,16 +84,34 @@ void SlamState::Predict(const MotionInput& input, double a_m) {
   P_.block(0, 3, 3, m) = P_.block(3, 0, m, 3).transpose();
 }
 
+bool SlamState::PredictWithJacobians(int k, Eigen::Vector2d* h,
+                                     Eigen::Matrix<double, 2, 3>* H_pose,
+                                     Eigen::Matrix2d* H_feature) const {
+  const int j = FeatureIndex(k);
+  auto corner_on_sensor = [&](const Eigen::VectorXd& xi) {
+    return types_[k] == FeatureType::kCorner &&
+           (xi.segment<2>(j) - SensorPose(xi.head<3>(), X_RS_).head<2>()).norm() <=
+               kMinCornerRange;
+  };
+  if (corner_on_sensor(x_)) return false;
+  if (jacobians_ == JacobianPoint::kCurrent) {
+    *h = PredictObservation(types_[k], pose(), feature(k), X_RS_, H_pose, H_feature);
+    return true;
+  }
+  if (corner_on_sensor(x_first_)) return false;
+  *h = PredictObservation(types_[k], pose(), feature(k), X_RS_);
+  Eigen::Vector2d h_first = PredictObservation(types_[k], x_first_.head<3>(),
+                                               x_first_.segment<2>(j), X_RS_, H_pose, H_feature);
+  // The Jacobians in h's polar form (a line's canonical form may differ at
+  // the two points).
+  if (types_[k] == FeatureType::kLine) AlignLineToObservation(*h, &h_first, H_pose, H_feature);
+  return true;
+}
+
 SlamState::Measurement SlamState::Measure(int k) const {
   MJSLAM_CHECK(k >= 0 && k < num_features());
   Measurement m;
-  const Eigen::Vector3d pose_WR = pose();
-  const Eigen::Vector2d f = feature(k);
-  if (types_[k] == FeatureType::kCorner) {
-    const Eigen::Vector3d pose_WS = SensorPose(pose_WR, X_RS_);
-    if ((f - pose_WS.head<2>()).norm() <= kMinCornerRange) return m;
-  }
-  m.h = PredictObservation(types_[k], pose_WR, f, X_RS_, &m.H_pose, &m.H_feature);
+  if (!PredictWithJacobians(k, &m.h, &m.H_pose, &m.H_feature)) return m;
 
   // H P H^T over the 5x5 block of the pose and the feature.
   Eigen::Matrix<double, 2, 5> H;
@@ -125,6 +153,19 @@ int SlamState::AddFeature(FeatureType type, const Eigen::Vector2d& z, const Eige
   Eigen::Matrix<double, 2, 3> G_pose;
   Eigen::Matrix2d G_z;
   const Eigen::Vector2d f = InitializeFeature(type, pose(), z, X_RS_, &G_pose, &G_z);
+  if (jacobians_ == JacobianPoint::kFirstEstimates) {
+    // G_pose at the pose's linearisation point and the feature's first
+    // estimate f: that of the observation z' = h(pose_lin, f), for which the
+    // inverse model gives f from pose_lin. Then G_pose carries the global
+    // translation and rotation of the pose over to f, as the FEJ H do.
+    const Eigen::Vector3d pose_lin = x_first_.head<3>();
+    const bool on_sensor = type == FeatureType::kCorner &&
+                           (f - SensorPose(pose_lin, X_RS_).head<2>()).norm() <= kMinCornerRange;
+    if (!on_sensor) {
+      const Eigen::Vector2d z_lin = PredictObservation(type, pose_lin, f, X_RS_);
+      InitializeFeature(type, pose_lin, z_lin, X_RS_, &G_pose, nullptr);
+    }
+  }
 
   const int j = n_;
   Reserve(n_ + 2);
@@ -173,6 +214,10 @@ int SlamState::AddLineIntersection(int a, int b) {
 int SlamState::Append(FeatureType type, const Eigen::Vector2d& f) {
   x_.conservativeResize(n_ + 2);
   x_.segment<2>(n_) = f;
+  if (jacobians_ == JacobianPoint::kFirstEstimates) {
+    x_first_.conservativeResize(n_ + 2);
+    x_first_.segment<2>(n_) = f;
+  }
   types_.push_back(type);
   n_ += 2;
   return num_features() - 1;
@@ -282,11 +327,10 @@ void SlamState::WrapAngles() {
 void SlamState::Update(int k, const Eigen::Vector2d& z, const Eigen::Matrix2d& R) {
   MJSLAM_CHECK(k >= 0 && k < num_features());
   // The prediction, its Jacobians and the innovation.
-  const Eigen::Vector3d pose_WR = pose();
   Eigen::Matrix<double, 2, 3> H_pose;
   Eigen::Matrix2d H_feature;
-  Eigen::Vector2d h = PredictObservation(types_[k], pose_WR, feature(k), X_RS_, &H_pose,
-                                         &H_feature);
+  Eigen::Vector2d h;
+  MJSLAM_CHECK(PredictWithJacobians(k, &h, &H_pose, &H_feature));
   if (types_[k] == FeatureType::kLine) AlignLineToObservation(z, &h, &H_pose, &H_feature);
   const Eigen::Vector2d nu = Innovation(z, h);
 

@@ -7,6 +7,7 @@
 #include "common/pose2.h"
 #include "slam/motion_model.h"
 #include "slam/observation_models.h"
+#include "slam/slam_params.h"
 
 namespace mjslam::slam {
 
@@ -45,9 +46,15 @@ class SlamState {
 
   /// A state with no features: pose (x, y, th) of R in W (metres, radians),
   /// its 3x3 covariance (symmetric PSD, may be zero), and the laser mount
-  /// X_RS used by the observation models.
+  /// X_RS used by the observation models. `jacobians`: where the prediction's
+  /// A and every observation's H are evaluated. kCurrent: at the current
+  /// mean. kFirstEstimates (FEJ): each feature at its first estimate (its
+  /// value when added), the pose at its predicted estimate of the current
+  /// step (the initial pose before the first prediction), and A of the
+  /// prediction from the previous predicted pose to the new one; the
+  /// predictions h themselves and W stay at the current mean.
   SlamState(const Eigen::Vector3d& pose_WR, const Eigen::Matrix3d& pose_covariance,
-            const Pose2& X_RS);
+            const Pose2& X_RS, JacobianPoint jacobians = JacobianPoint::kCurrent);
 
   /// n = 3 + 2 L.
   int dimension() const { return n_; }
@@ -78,11 +85,18 @@ class SlamState {
   Eigen::Matrix<double, 5, 5> JointCovariance(int k) const;
   /// The laser mount.
   const Pose2& X_RS() const { return X_RS_; }
+  /// The points the Jacobians are evaluated at (size n): with
+  /// kFirstEstimates the pose's predicted estimate and each feature's first
+  /// estimate; with kCurrent the mean.
+  const Eigen::VectorXd& linearization_point() const {
+    return jacobians_ == JacobianPoint::kFirstEstimates ? x_first_ : x_;
+  }
   /// Columns allocated for P (>= n), for tests of the growth policy.
   int capacity() const { return static_cast<int>(P_.cols()); }
 
   /// Prediction, Eqs. (1)-(2) with Eq. (6): pose <- f(pose, increment),
-  /// P <- A P A^T + W Q W^T + s^2 n n^T with Q = input.covariance, for the
+  /// P <- A P A^T + W Q W^T + s^2 n n^T with Q = input.covariance (A at the
+  /// mean, or from the previous predicted pose with kFirstEstimates), for the
   /// control point `a_m` ahead of the axle; s^2 = input.lateral_variance_m2
   /// and n the unit vector across the mid-arc heading (position rows only).
   /// O(n): only the pose rows and columns change.
@@ -99,6 +113,8 @@ class SlamState {
   /// covariance R (2x2 SPD) by the inverse observation model g:
   ///   f = g(pose, z),  P_ff = G_pose P_pp G_pose^T + G_z R G_z^T,
   ///   P_fx = G_pose P_px  (the pose rows of P, all columns).
+  /// With kFirstEstimates, G_pose is taken at the pose's linearisation point
+  /// and f (that of the observation h(pose_lin, f)).
   /// O(n) (amortised: the buffer doubles when full). Returns the new index k.
   int AddFeature(FeatureType type, const Eigen::Vector2d& z, const Eigen::Matrix2d& R);
 
@@ -142,12 +158,22 @@ class SlamState {
   void ApplyGain(const Eigen::Vector2d& w);
   // Wraps the heading and every line's alpha into (-pi, pi].
   void WrapAngles();
+  // The prediction h of feature k at the mean and its Jacobians at the
+  // linearisation point (linearization_point()), a line's Jacobians in the
+  // polar form of h. False when the model is undefined at either point (a
+  // corner at the sensor).
+  bool PredictWithJacobians(int k, Eigen::Vector2d* h, Eigen::Matrix<double, 2, 3>* H_pose,
+                            Eigen::Matrix2d* H_feature) const;
 
   Pose2 X_RS_;
   int n_ = 3;
   Eigen::VectorXd x_;
   // Capacity x capacity buffer; P is its top-left n_ x n_ block.
   Eigen::MatrixXd P_;
+  JacobianPoint jacobians_;
+  // With kFirstEstimates: the pose's predicted estimate and the features'
+  // first estimates (size n); empty otherwise.
+  Eigen::VectorXd x_first_;
   std::vector<FeatureType> types_;
   // Scratch for P H^T and V, capacity x 2.
   Eigen::MatrixXd scratch_;
