@@ -92,65 +92,78 @@ TEST(FirstEstimatesTest, HeadingNeverMoreCertainThanTheInitialHeading) {
   }
 }
 
-TEST(FirstEstimatesTest, JacobiansAtTheFirstEstimateAndThePredictedPose) {
-  // A corner, corrected once: its estimate and the pose move, but the
-  // Jacobians of the next observation stay those at the corner's first
-  // estimate and at the pose's predicted estimate; the prediction h is at
-  // the current mean.
-  const Pose2 X_RS(0.1, 0.0, 0.0);
-  SlamState state(Eigen::Vector3d(1.0, 2.0, 0.3), Eigen::Matrix3d::Identity() * 0.01, X_RS,
-                  JacobianPoint::kFirstEstimates);
-  const Eigen::Vector2d z(3.0, 0.4);
-  const int k = state.AddFeature(FeatureType::kCorner, z, Eigen::Matrix2d::Identity() * 0.01);
-  const Eigen::Vector2d corner_first = state.feature(k);
+// A state with one corner, a noisy prediction and one correction that moves
+// the corner and the pose: what the two Jacobian tests below start from.
+struct CorrectedOnce {
+  SlamState state;
+  int k;
+  Eigen::Vector2d corner_first;
+  Eigen::Vector3d pose_predicted;
+};
+
+CorrectedOnce CornerCorrectedOnce(JacobianPoint jacobians, const Pose2& X_RS) {
+  const Eigen::Matrix2d R = Eigen::Matrix2d::Identity() * 0.01;
+  CorrectedOnce c{SlamState(Eigen::Vector3d(1.0, 2.0, 0.3), Eigen::Matrix3d::Identity() * 0.01,
+                            X_RS, jacobians),
+                  0, Eigen::Vector2d::Zero(), Eigen::Vector3d::Zero()};
+  c.k = c.state.AddFeature(FeatureType::kCorner, Eigen::Vector2d(3.0, 0.4), R);
+  c.corner_first = c.state.feature(c.k);
   MotionInput input;  // a noisy step, so that the correction moves the pose
   input.increment = Eigen::Vector2d(0.5, 0.1);
   input.covariance = Eigen::Matrix2d::Identity() * 0.01;
-  state.Predict(input, 0.2);
-  const Eigen::Vector3d pose_first = state.pose();
-  const Eigen::Vector2d z_next = PredictCorner(pose_first, corner_first, X_RS);
-  state.Update(k, z_next + Eigen::Vector2d(0.2, -0.05), Eigen::Matrix2d::Identity() * 0.01);
-  ASSERT_GT((state.feature(k) - corner_first).norm(), 1e-3);
-  ASSERT_GT((state.pose() - pose_first).norm(), 1e-3);
+  c.state.Predict(input, 0.2);
+  c.pose_predicted = c.state.pose();
+  const Eigen::Vector2d z = PredictCorner(c.pose_predicted, c.corner_first, X_RS);
+  c.state.Update(c.k, z + Eigen::Vector2d(0.2, -0.05), R);
+  return c;
+}
 
-  const SlamState::Measurement m = state.Measure(k);
+TEST(FirstEstimatesTest, JacobiansAtTheFirstEstimateAndThePredictedPose) {
+  // The corner's estimate and the pose moved, but the Jacobians of the next
+  // observation stay those at the corner's first estimate and at the pose's
+  // predicted estimate; the prediction h is at the current mean.
+  const Pose2 X_RS(0.1, 0.0, 0.0);
+  const CorrectedOnce fej = CornerCorrectedOnce(JacobianPoint::kFirstEstimates, X_RS);
+  ASSERT_GT((fej.state.feature(fej.k) - fej.corner_first).norm(), 1e-3);
+  ASSERT_GT((fej.state.pose() - fej.pose_predicted).norm(), 1e-3);
+  const SlamState::Measurement m = fej.state.Measure(fej.k);
   Eigen::Matrix<double, 2, 3> H_pose;
   Eigen::Matrix2d H_feature;
-  PredictCorner(pose_first, corner_first, X_RS, &H_pose, &H_feature);
+  PredictCorner(fej.pose_predicted, fej.corner_first, X_RS, &H_pose, &H_feature);
   EXPECT_TRUE(m.H_pose.isApprox(H_pose, 1e-12)) << m.H_pose << "\n" << H_pose;
   EXPECT_TRUE(m.H_feature.isApprox(H_feature, 1e-12));
-  EXPECT_TRUE(m.h.isApprox(PredictCorner(state.pose(), state.feature(k), X_RS), 1e-12));
+  EXPECT_TRUE(
+      m.h.isApprox(PredictCorner(fej.state.pose(), fej.state.feature(fej.k), X_RS), 1e-12));
 
   // The same steps with Jacobians at the current estimate differ.
-  SlamState standard(Eigen::Vector3d(1.0, 2.0, 0.3), Eigen::Matrix3d::Identity() * 0.01, X_RS);
-  standard.AddFeature(FeatureType::kCorner, z, Eigen::Matrix2d::Identity() * 0.01);
-  standard.Predict(input, 0.2);
-  standard.Update(k, z_next + Eigen::Vector2d(0.2, -0.05), Eigen::Matrix2d::Identity() * 0.01);
-  EXPECT_FALSE(standard.Measure(k).H_pose.isApprox(H_pose, 1e-6));
+  const CorrectedOnce standard = CornerCorrectedOnce(JacobianPoint::kCurrent, X_RS);
+  EXPECT_FALSE(standard.state.Measure(standard.k).H_pose.isApprox(H_pose, 1e-6));
 }
 
 TEST(FirstEstimatesTest, PredictionJacobianFromThePreviousPredictedPose) {
-  // After a correction moves the pose, FEJ's A uses the displacement from
+  // After the correction moved the pose, FEJ's A uses the displacement from
   // the pose predicted before the correction to the new prediction: the
-  // cross-covariance of a feature with x picks up A(0, 2) times its
-  // covariance with the heading.
+  // cross-covariance of the feature with x and y picks up A(0, 2) and A(1, 2)
+  // times its covariance with the heading.
   const Pose2 X_RS(0.1, 0.0, 0.0);
-  SlamState state(Eigen::Vector3d(0.0, 0.0, 0.0), Eigen::Matrix3d::Identity() * 0.01, X_RS,
-                  JacobianPoint::kFirstEstimates);
-  const Eigen::Vector2d z(3.0, 0.4);
-  const int k = state.AddFeature(FeatureType::kCorner, z, Eigen::Matrix2d::Identity() * 0.01);
-  const Eigen::Vector3d predicted_before = state.pose();  // no prediction yet: the initial pose
-  state.Update(k, z + Eigen::Vector2d(0.2, -0.05), Eigen::Matrix2d::Identity() * 0.01);
-  const Eigen::MatrixXd P = state.covariance();
+  CorrectedOnce fej = CornerCorrectedOnce(JacobianPoint::kFirstEstimates, X_RS);
+  const Eigen::Vector3d corrected = fej.state.pose();
+  ASSERT_GT((corrected - fej.pose_predicted).norm(), 1e-3);
+  const Eigen::MatrixXd P = fej.state.covariance();
   MotionInput input;
   input.increment = Eigen::Vector2d(0.5, 0.2);
-  state.Predict(input, 0.2);
-  const double A02 = -(state.pose().y() - predicted_before.y());
-  const double A12 = state.pose().x() - predicted_before.x();
-  const int j = SlamState::FeatureIndex(k);
-  EXPECT_NEAR(state.covariance()(j, 0), P(j, 0) + A02 * P(j, 2), 1e-15);
-  EXPECT_NEAR(state.covariance()(j, 1), P(j, 1) + A12 * P(j, 2), 1e-15);
-  EXPECT_EQ(state.linearization_point().head<3>(), state.pose());
+  fej.state.Predict(input, 0.2);
+  const Eigen::Vector3d predicted = fej.state.pose();
+  const int j = SlamState::FeatureIndex(fej.k);
+  const double A02 = -(predicted.y() - fej.pose_predicted.y());
+  const double A12 = predicted.x() - fej.pose_predicted.x();
+  EXPECT_NEAR(fej.state.covariance()(j, 0), P(j, 0) + A02 * P(j, 2), 1e-15);
+  EXPECT_NEAR(fej.state.covariance()(j, 1), P(j, 1) + A12 * P(j, 2), 1e-15);
+  // The standard A, from the corrected pose, would give another value.
+  EXPECT_GT(std::abs(fej.state.covariance()(j, 0) -
+                     (P(j, 0) - (predicted.y() - corrected.y()) * P(j, 2))),
+            1e-9);
+  EXPECT_EQ(fej.state.linearization_point().head<3>(), predicted);
 }
 
 TEST(CommandGainTest, ScalesTheIncrementNotTheNoise) {
