@@ -46,6 +46,9 @@ struct ImportReport {
   int num_odometry = 0;
   int num_steps = 0;
   bool has_reference = false;
+  /// Whether the odometry was rebuilt from the increments of a log that
+  /// restarts it at each scan (realdata::CarmenLog::reanchored).
+  bool odometry_rebuilt = false;
   double time_offset_s = 0.0;
   /// realdata::SkipReport of the log, plus the scans left out by the import.
   std::vector<std::string> skipped;

@@ -206,6 +206,9 @@ CLI::App* AddImport(CLI::App* cli, ImportCommand* c) {
                      "The laser poses as reference trajectory: auto, yes, no")->capture_default_str();
   import->add_flag("--skip-bad-lines", c->options.read.skip_bad_lines,
                    "Count and report malformed lines instead of stopping at the first");
+  import->add_flag("--odometry-as-logged", c->options.read.odometry_as_logged,
+                   "Keep ODOM poses as logged where the log restarts them at each scan's corrected "
+                   "pose (the corrected logs), instead of rebuilding the wheel odometry");
   import->add_option("--relations", c->options.relations_path, "Relations file (Kuemmerle et al. 2009)");
   import->add_option("--time-offset", c->time_offset,
                      "Relation time minus log time, seconds, or auto (searched)")->capture_default_str();
@@ -231,6 +234,9 @@ int ImportMain(ImportCommand c, const std::string& command_line) {
                c.options.out_dir.c_str(), c.options.log_path.c_str(), report.num_scans,
                report.laser.c_str(), report.num_beams, report.num_odometry, report.num_steps,
                report.has_reference ? "reference trajectory (the log's own estimate)" : "no reference");
+  if (report.odometry_rebuilt) {
+    std::fprintf(stderr, "  odometry rebuilt from the logged increments (the log restarts it at each scan)\n");
+  }
   for (const std::string& line : report.skipped) std::fprintf(stderr, "  skipped %s\n", line.c_str());
   if (!c.options.relations_path.empty()) {
     std::fprintf(stderr, "  relations time offset %.6f s\n", report.time_offset_s);
