@@ -41,7 +41,7 @@ const std::vector<LaserMessage>& ChooseLaser(const CarmenLog& log, const std::st
     return it->second;
   }
   for (const char* kind : {"FLASER", "ROBOTLASER1", "RAWLASER1", "RLASER", "ROBOTLASER2",
-                           "RAWLASER2", "RAWLASER3", "RAWLASER4"}) {
+                           "RAWLASER2", "RAWLASER3", "RAWLASER4", realdata::kBreezySlamLaser}) {
     const auto it = log.lasers.find(kind);
     if (it != log.lasers.end() && !it->second.empty()) return it->second;
   }
@@ -256,12 +256,27 @@ nlohmann::json ManifestFields(const ImportOptions& options, const ImportReport& 
           {"command_line", options.command_line}};
 }
 
+// The log in the reader's common form, read by its format.
+CarmenLog ReadLog(const ImportOptions& options) {
+  const std::string& format = options.format;
+  if (format != "auto" && format != "carmen" && format != "breezyslam") {
+    throw std::runtime_error("--format: expected auto, carmen or breezyslam (got '" + format + "')");
+  }
+  realdata::BreezySlamOptions breezyslam = options.breezyslam;
+  if (options.read.max_range_m > 0.0) breezyslam.max_range_m = options.read.max_range_m;
+  if (format == "breezyslam" ||
+      (format == "auto" && realdata::LooksLikeBreezySlamLog(options.log_path, breezyslam))) {
+    return realdata::ReadBreezySlamLog(options.log_path, breezyslam);
+  }
+  return realdata::ReadCarmenLog(options.log_path, options.read);
+}
+
 }  // namespace
 
 // Reads the log, sets the config's laser from it, writes the recording and
 // the manifest, then replays the recording into the same directory.
 ImportReport ImportLog(RunConfig config, const ImportOptions& options) {
-  const CarmenLog log = realdata::ReadCarmenLog(options.log_path, options.read);
+  const CarmenLog log = ReadLog(options);
   const std::vector<LaserMessage>& all_scans = ChooseLaser(log, options.laser);
   CheckSameLayout(log, all_scans);
   const LaserMessage& first = all_scans.front();

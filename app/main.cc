@@ -188,9 +188,11 @@ struct ImportCommand {
 CLI::App* AddImport(CLI::App* cli, ImportCommand* c) {
   c->config.path = std::string(MJSLAM_SOURCE_DIR) + "/configs/real.yaml";
   CLI::App* import = cli->add_subcommand(
-      "import", "Import a CARMEN laser log (plain or gzip) into a run directory and run both filters on it");
+      "import", "Import a CARMEN laser log (plain or gzip) or a BreezySLAM log into a run directory and run both filters on it");
   import->add_option("LOG", c->options.log_path, "CARMEN log")->required();
   import->add_option("--out", c->options.out_dir, "Output run directory")->required();
+  import->add_option("--format", c->options.format,
+                     "Log format: auto, carmen, breezyslam (docs/real_data.md)")->capture_default_str();
   import->add_option("--laser", c->options.laser,
                      "Laser messages to use (FLASER, RLASER, ROBOTLASER1, RAWLASER1, ...) [first found]");
   import->add_option("--angle-min-deg", c->options.read.angle_min_deg,
