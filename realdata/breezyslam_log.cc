@@ -1,5 +1,6 @@
 #include "realdata/breezyslam_log.h"
 
+#include <charconv>
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
@@ -55,10 +56,10 @@ CarmenLog ReadBreezySlamLog(const std::string& path, const BreezySlamOptions& op
   if (!in) throw std::runtime_error(path + ": cannot open");
   CarmenLog log;
   log.path = path;
-  std::ostringstream offset;
-  offset.precision(17);
-  offset << options.laser_offset_m;
-  log.params["robot_frontlaser_offset"] = offset.str();
+  char offset[32];
+  const std::to_chars_result written =
+      std::to_chars(offset, offset + sizeof(offset), options.laser_offset_m);  // shortest exact
+  log.params["robot_frontlaser_offset"] = std::string(offset, written.ptr);
   std::vector<LaserMessage>& scans = log.lasers[kBreezySlamLaser];
   const int fields = BreezySlamFieldsPerLine(options.num_beams);
   const double radians_per_tick = 2.0 * kPi / options.ticks_per_revolution;
