@@ -4,7 +4,6 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
-#include <sstream>
 #include <stdexcept>
 #include <vector>
 
@@ -17,14 +16,6 @@ constexpr double kDegToRad = kPi / 180.0;
 constexpr int kFieldsBeforeRanges = 24;
 constexpr int kLeftTicksField = 2;
 constexpr int kRightTicksField = 3;
-
-std::vector<std::string> SplitTokens(const std::string& line) {
-  std::vector<std::string> tokens;
-  std::istringstream in(line);
-  std::string token;
-  while (in >> token) tokens.push_back(token);
-  return tokens;
-}
 
 // The integer of field `i`, or an error naming the field.
 long long Integer(const std::vector<std::string>& tokens, int i) {
@@ -68,7 +59,7 @@ CarmenLog ReadBreezySlamLog(const std::string& path, const BreezySlamOptions& op
   std::string line;
   while (std::getline(in, line)) {
     const int line_number = ++log.num_lines;
-    const std::vector<std::string> tokens = SplitTokens(line);
+    const std::vector<std::string> tokens = SplitLogFields(line);
     if (tokens.empty()) continue;
     const std::string where = path + ":" + std::to_string(line_number) + ": ";
     if (static_cast<int>(tokens.size()) != fields) {
@@ -127,7 +118,7 @@ bool LooksLikeBreezySlamLog(const std::string& path, const BreezySlamOptions& op
   std::ifstream in(path);
   std::string line;
   if (!in || !std::getline(in, line)) return false;
-  const std::vector<std::string> tokens = SplitTokens(line);
+  const std::vector<std::string> tokens = SplitLogFields(line);
   if (static_cast<int>(tokens.size()) != BreezySlamFieldsPerLine(options.num_beams)) return false;
   try {
     for (int i : {0, kLeftTicksField, kRightTicksField}) Integer(tokens, i);

@@ -24,14 +24,6 @@ struct BadLine : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-std::vector<std::string> SplitTokens(const std::string& line) {
-  std::vector<std::string> tokens;
-  std::istringstream in(line);
-  std::string token;
-  while (in >> token) tokens.push_back(token);
-  return tokens;
-}
-
 // Reads the lines of a plain or gzip file (zlib passes plain files through).
 class LineReader {
  public:
@@ -251,14 +243,14 @@ CarmenLog ReadCarmenLog(const std::string& path, const CarmenReadOptions& option
   OdometryChain chain;
   while (reader.Next(&line)) {
     const int line_number = ++log.num_lines;
-    std::vector<std::string> tokens = SplitTokens(line);
+    std::vector<std::string> tokens = SplitLogFields(line);
     if (tokens.empty() || tokens[0][0] == '#') continue;
     const std::string kind = tokens[0];
     Fields fields(std::move(tokens));
     try {
       if (kind == "PARAM") {
         if (fields.size() < 3) throw BadLine("PARAM: expected a name and a value");
-        std::vector<std::string> pair = SplitTokens(line);
+        std::vector<std::string> pair = SplitLogFields(line);
         log.params[pair[1]] = pair[2];
       } else if (kind == "ODOM") {
         OdometryMessage odom = ParseOdom(fields);
@@ -307,6 +299,14 @@ CarmenLog ReadCarmenLog(const std::string& path, const CarmenReadOptions& option
     }
   }
   return log;
+}
+
+std::vector<std::string> SplitLogFields(const std::string& line) {
+  std::vector<std::string> tokens;
+  std::istringstream in(line);
+  std::string token;
+  while (in >> token) tokens.push_back(token);
+  return tokens;
 }
 
 std::vector<std::string> SkipReport(const CarmenLog& log) {

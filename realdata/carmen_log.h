@@ -115,6 +115,9 @@ double CarmenDefaultStepDeg(int num_beams);
 /// (the corrected logs' pose lines, corrupt stamps) is skipped and counted.
 CarmenLog ReadCarmenLog(const std::string& path, const CarmenReadOptions& options = {});
 
+/// The whitespace-separated fields of one line of a text log.
+std::vector<std::string> SplitLogFields(const std::string& line);
+
 /// The skip counts of `log` as one line each ("NEFF: not read: 910 lines").
 std::vector<std::string> SkipReport(const CarmenLog& log);
 
