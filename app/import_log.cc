@@ -41,7 +41,7 @@ const std::vector<LaserMessage>& ChooseLaser(const CarmenLog& log, const std::st
     return it->second;
   }
   for (const char* kind : {"FLASER", "ROBOTLASER1", "RAWLASER1", "RLASER", "ROBOTLASER2",
-                           "RAWLASER2", "RAWLASER3", "RAWLASER4"}) {
+                           "RAWLASER2", "RAWLASER3", "RAWLASER4", realdata::kBreezySlamLaser}) {
     const auto it = log.lasers.find(kind);
     if (it != log.lasers.end() && !it->second.empty()) return it->second;
   }
@@ -224,7 +224,7 @@ int WriteRecording(const Stream& s, const std::string& dir) {
 // The manifest of an imported run: the source, the layout, the counts, the
 // reference and the relations' matching.
 nlohmann::json ManifestFields(const ImportOptions& options, const ImportReport& report,
-                              const LaserMessage& first, const Stream& s) {
+                              const LaserMessage& first, const Stream& s, bool log_reanchored) {
   nlohmann::json skipped = nlohmann::json::array();
   for (const std::string& line : report.skipped) skipped.push_back(line);
   return {{"mode", "import"},
@@ -238,6 +238,11 @@ nlohmann::json ManifestFields(const ImportOptions& options, const ImportReport& 
           {"laser_offset_m", s.X_BS.x},
           {"num_scans", report.num_scans},
           {"num_odometry", report.num_odometry},
+          {"odometry", !log_reanchored ? "as logged"
+                       : report.odometry_rebuilt
+                           ? "rebuilt from the logged increments (the log restarts its ODOM "
+                             "lines at each scan's corrected pose)"
+                           : "as logged (restarted at each scan's corrected pose)"},
           {"skipped", skipped},
           {"reference", s.has_reference ? "reference.csv: the log's own pose estimate (a SLAM "
                                           "result, not ground truth)"
@@ -251,12 +256,27 @@ nlohmann::json ManifestFields(const ImportOptions& options, const ImportReport& 
           {"command_line", options.command_line}};
 }
 
+// The log in the reader's common form, read by its format.
+CarmenLog ReadLog(const ImportOptions& options) {
+  const std::string& format = options.format;
+  if (format != "auto" && format != "carmen" && format != "breezyslam") {
+    throw std::runtime_error("--format: expected auto, carmen or breezyslam (got '" + format + "')");
+  }
+  realdata::BreezySlamOptions breezyslam = options.breezyslam;
+  if (options.read.max_range_m > 0.0) breezyslam.max_range_m = options.read.max_range_m;
+  if (format == "breezyslam" ||
+      (format == "auto" && realdata::LooksLikeBreezySlamLog(options.log_path, breezyslam))) {
+    return realdata::ReadBreezySlamLog(options.log_path, breezyslam);
+  }
+  return realdata::ReadCarmenLog(options.log_path, options.read);
+}
+
 }  // namespace
 
 // Reads the log, sets the config's laser from it, writes the recording and
 // the manifest, then replays the recording into the same directory.
 ImportReport ImportLog(RunConfig config, const ImportOptions& options) {
-  const CarmenLog log = realdata::ReadCarmenLog(options.log_path, options.read);
+  const CarmenLog log = ReadLog(options);
   const std::vector<LaserMessage>& all_scans = ChooseLaser(log, options.laser);
   CheckSameLayout(log, all_scans);
   const LaserMessage& first = all_scans.front();
@@ -297,6 +317,7 @@ ImportReport ImportLog(RunConfig config, const ImportOptions& options) {
   report.num_scans = static_cast<int>(s.scans.size());
   report.num_odometry = static_cast<int>(s.odometry.size());
   report.has_reference = s.has_reference;
+  report.odometry_rebuilt = log.reanchored && !options.read.odometry_as_logged;
   report.skipped = realdata::SkipReport(log);
   if (s.scans_outside > 0) {
     report.skipped.push_back(first.kind + ": outside the odometry's time span: " +
@@ -313,7 +334,7 @@ ImportReport ImportLog(RunConfig config, const ImportOptions& options) {
   const std::string& dir = options.out_dir;
   const rundir::RunDirectoryLock lock(dir);
   rundir::WriteFileAtomically(rundir::PathIn(dir, rundir::kConfigFile), config::ToYaml(config));
-  rundir::ManifestWriter manifest(dir, ManifestFields(options, report, first, s));
+  rundir::ManifestWriter manifest(dir, ManifestFields(options, report, first, s, log.reanchored));
   manifest.SetLaserMount(s.X_BR.Inverse() * s.X_BS);
   manifest.Write();
   report.num_steps = WriteRecording(s, dir);

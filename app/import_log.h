@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "app/run_config.h"
+#include "realdata/breezyslam_log.h"
 #include "realdata/carmen_log.h"
 
 namespace mjslam::app {
@@ -17,8 +18,14 @@ struct ImportOptions {
   std::string out_dir;
   std::string config_path;
   std::string command_line;
-  /// How to read the log (beam layout, maximum range, bad lines).
+  /// The log's format: "carmen", "breezyslam" or "auto" (breezyslam when
+  /// realdata::LooksLikeBreezySlamLog, else carmen).
+  std::string format = "auto";
+  /// How to read a CARMEN log (beam layout, maximum range, bad lines); its
+  /// max_range_m, when > 0, also replaces a BreezySLAM log's.
   realdata::CarmenReadOptions read;
+  /// The rover and laser of a BreezySLAM log.
+  realdata::BreezySlamOptions breezyslam;
   /// The laser message stream to use (FLASER, RLASER, ROBOTLASER1, ...);
   /// empty: the first of FLASER, ROBOTLASER1, RAWLASER1 the log has.
   std::string laser;
@@ -46,12 +53,15 @@ struct ImportReport {
   int num_odometry = 0;
   int num_steps = 0;
   bool has_reference = false;
+  /// Whether the odometry was rebuilt from the increments of a log that
+  /// restarts it at each scan (realdata::CarmenLog::reanchored).
+  bool odometry_rebuilt = false;
   double time_offset_s = 0.0;
   /// realdata::SkipReport of the log, plus the scans left out by the import.
   std::vector<std::string> skipped;
 };
 
-/// `mjslam import`: reads a CARMEN log and writes a run directory that
+/// `mjslam import`: reads a CARMEN or BreezySLAM log and writes a run directory that
 /// replay, evaluate and render understand, then runs both filters on it:
 /// config.yaml (`config` with laser.num_beams, fov_deg and max_range_m of
 /// the log), manifest.json (mode "import", the source, the counts, the

@@ -188,9 +188,11 @@ struct ImportCommand {
 CLI::App* AddImport(CLI::App* cli, ImportCommand* c) {
   c->config.path = std::string(MJSLAM_SOURCE_DIR) + "/configs/real.yaml";
   CLI::App* import = cli->add_subcommand(
-      "import", "Import a CARMEN laser log (plain or gzip) into a run directory and run both filters on it");
+      "import", "Import a CARMEN laser log (plain or gzip) or a BreezySLAM log into a run directory and run both filters on it");
   import->add_option("LOG", c->options.log_path, "CARMEN log")->required();
   import->add_option("--out", c->options.out_dir, "Output run directory")->required();
+  import->add_option("--format", c->options.format,
+                     "Log format: auto, carmen, breezyslam (docs/real_data.md)")->capture_default_str();
   import->add_option("--laser", c->options.laser,
                      "Laser messages to use (FLASER, RLASER, ROBOTLASER1, RAWLASER1, ...) [first found]");
   import->add_option("--angle-min-deg", c->options.read.angle_min_deg,
@@ -206,6 +208,9 @@ CLI::App* AddImport(CLI::App* cli, ImportCommand* c) {
                      "The laser poses as reference trajectory: auto, yes, no")->capture_default_str();
   import->add_flag("--skip-bad-lines", c->options.read.skip_bad_lines,
                    "Count and report malformed lines instead of stopping at the first");
+  import->add_flag("--odometry-as-logged", c->options.read.odometry_as_logged,
+                   "Keep ODOM poses as logged where the log restarts them at each scan's corrected "
+                   "pose (the corrected logs), instead of rebuilding the wheel odometry");
   import->add_option("--relations", c->options.relations_path, "Relations file (Kuemmerle et al. 2009)");
   import->add_option("--time-offset", c->time_offset,
                      "Relation time minus log time, seconds, or auto (searched)")->capture_default_str();
@@ -231,6 +236,9 @@ int ImportMain(ImportCommand c, const std::string& command_line) {
                c.options.out_dir.c_str(), c.options.log_path.c_str(), report.num_scans,
                report.laser.c_str(), report.num_beams, report.num_odometry, report.num_steps,
                report.has_reference ? "reference trajectory (the log's own estimate)" : "no reference");
+  if (report.odometry_rebuilt) {
+    std::fprintf(stderr, "  odometry rebuilt from the logged increments (the log restarts it at each scan)\n");
+  }
   for (const std::string& line : report.skipped) std::fprintf(stderr, "  skipped %s\n", line.c_str());
   if (!c.options.relations_path.empty()) {
     std::fprintf(stderr, "  relations time offset %.6f s\n", report.time_offset_s);

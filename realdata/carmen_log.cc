@@ -24,14 +24,6 @@ struct BadLine : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-std::vector<std::string> SplitTokens(const std::string& line) {
-  std::vector<std::string> tokens;
-  std::istringstream in(line);
-  std::string token;
-  while (in >> token) tokens.push_back(token);
-  return tokens;
-}
-
 // Reads the lines of a plain or gzip file (zlib passes plain files through).
 class LineReader {
  public:
@@ -179,6 +171,41 @@ double OldLaserMaxRange(const CarmenLog& log, const CarmenReadOptions& options) 
   return kSickNoReturnM;
 }
 
+// Whether two logged poses are the same numbers (as printed, to the last
+// digit): the corrected logs' ODOM copy of a scan's pose.
+bool SamePose(const Pose2& a, const Pose2& b) {
+  constexpr double kPrinted = 1e-9;
+  return std::abs(a.x - b.x) <= kPrinted && std::abs(a.y - b.y) <= kPrinted &&
+         std::abs(WrapAngle(a.theta - b.theta)) <= kPrinted;
+}
+
+// The odometry of a log whose ODOM lines restart from each scan's corrected
+// pose (CarmenLog::reanchored): the pose of each ODOM line, rebuilt by
+// chaining the logged increments (each from the line before, or from the
+// scan's pose at the start of a segment) in log order.
+class OdometryChain {
+ public:
+  // The pose to keep for an ODOM line logged at `logged`: `logged` itself,
+  // or, when `rebuild`, the chain's pose.
+  Pose2 Next(const Pose2& logged, bool rebuild) {
+    rebuilt_ = rebuild && started_ ? rebuilt_ * (anchor_.Inverse() * logged) : logged;
+    anchor_ = logged;
+    started_ = true;
+    return rebuilt_;
+  }
+  // A segment starts: the next increment is measured from `logged`, which is
+  // where the odometry is now.
+  void Reanchor(const Pose2& logged) {
+    anchor_ = logged;
+    started_ = true;
+  }
+
+ private:
+  Pose2 anchor_;
+  Pose2 rebuilt_;
+  bool started_ = false;
+};
+
 // Keeps a message whose timestamp is positive and after the last one kept.
 template <typename Message>
 void Keep(Message message, const std::string& kind, std::vector<Message>* stream, CarmenLog* log) {
@@ -209,23 +236,38 @@ CarmenLog ReadCarmenLog(const std::string& path, const CarmenReadOptions& option
   // just before the current line.
   OdometryMessage last_odom;
   bool odom_just_before = false;
+  // The laser message of the line before, when it carries poses: an ODOM
+  // line repeating its robot pose re-anchors the odometry.
+  LaserMessage laser_seen;
+  const LaserMessage* laser_just_before = nullptr;
+  OdometryChain chain;
   while (reader.Next(&line)) {
     const int line_number = ++log.num_lines;
-    std::vector<std::string> tokens = SplitTokens(line);
+    std::vector<std::string> tokens = SplitLogFields(line);
     if (tokens.empty() || tokens[0][0] == '#') continue;
     const std::string kind = tokens[0];
     Fields fields(std::move(tokens));
     try {
       if (kind == "PARAM") {
         if (fields.size() < 3) throw BadLine("PARAM: expected a name and a value");
-        std::vector<std::string> pair = SplitTokens(line);
+        std::vector<std::string> pair = SplitLogFields(line);
         log.params[pair[1]] = pair[2];
       } else if (kind == "ODOM") {
         OdometryMessage odom = ParseOdom(fields);
         odom.line = line_number;
+        if (laser_just_before != nullptr && SamePose(odom.pose, laser_just_before->robot_pose)) {
+          log.reanchored = true;
+          chain.Reanchor(odom.pose);
+          ++log.skipped["ODOM: the scan's corrected pose (restarts the logged odometry)"];
+          laser_just_before = nullptr;
+          odom_just_before = false;
+          continue;
+        }
+        odom.pose = chain.Next(odom.pose, log.reanchored && !options.odometry_as_logged);
         Keep(odom, kind, &log.odometry, &log);
         last_odom = odom;
         odom_just_before = true;
+        laser_just_before = nullptr;
         continue;
       } else if (kind == "FLASER" || kind == "RLASER" || IsNewLaser(kind, "RAWLASER") ||
                  IsNewLaser(kind, "ROBOTLASER")) {
@@ -237,20 +279,34 @@ CarmenLog ReadCarmenLog(const std::string& path, const CarmenReadOptions& option
         laser.line = line_number;
         laser.has_odometry_at_scan = odom_just_before && last_odom.t_s == laser.t_s;
         laser.odometry_at_scan = last_odom.pose;
+        laser_seen = laser;
         Keep(laser, kind, &log.lasers[kind], &log);
+        odom_just_before = false;
+        laser_just_before = laser_seen.has_poses ? &laser_seen : nullptr;
+        continue;
       } else {
         ++log.skipped[kind + ": not read"];
       }
       odom_just_before = false;
+      laser_just_before = nullptr;
     } catch (const BadLine& bad) {
       const std::string message = path + ":" + std::to_string(line_number) + ": " + bad.what();
       if (!options.skip_bad_lines) throw std::runtime_error(message);
       odom_just_before = false;
+      laser_just_before = nullptr;
       ++log.skipped["bad line"];
       if (log.bad_lines.size() < kMaxBadLinesKept) log.bad_lines.push_back(message);
     }
   }
   return log;
+}
+
+std::vector<std::string> SplitLogFields(const std::string& line) {
+  std::vector<std::string> tokens;
+  std::istringstream in(line);
+  std::string token;
+  while (in >> token) tokens.push_back(token);
+  return tokens;
 }
 
 std::vector<std::string> SkipReport(const CarmenLog& log) {

@@ -15,7 +15,9 @@ namespace mjslam::realdata {
 struct OdometryMessage {
   /// The message's ipc timestamp, seconds.
   double t_s = 0.0;
-  /// x y theta of the robot in the odometry frame.
+  /// x y theta of the robot in the odometry frame: as logged, or, in a log
+  /// whose odometry restarts from each scan's corrected pose
+  /// (CarmenLog::reanchored), rebuilt from the logged increments.
   Pose2 pose;
   /// Translational and rotational velocity the robot reported (m/s, rad/s).
   double tv_mps = 0.0;
@@ -67,6 +69,9 @@ struct CarmenReadOptions {
   /// A malformed line (wrong field count, a field that is not a number) is
   /// an error naming the line (false, the default) or a counted skip.
   bool skip_bad_lines = false;
+  /// Keep the ODOM poses as logged even where the log re-anchors them at
+  /// each scan (CarmenLog::reanchored), instead of rebuilding the odometry.
+  bool odometry_as_logged = false;
 };
 
 /// A whole log: the messages kept, the parameters, and what was skipped.
@@ -86,6 +91,15 @@ struct CarmenLog {
   std::vector<std::string> bad_lines;
   /// Lines read.
   int num_lines = 0;
+  /// Whether the log re-anchors its odometry: an ODOM line right after a
+  /// laser message repeats the message's robot pose (the corrected logs
+  /// write each scan's corrected pose so, with timestamp 0), and the ODOM
+  /// lines after it continue from that pose, o(t) = C_k (+) R(t_k)^-1 (+)
+  /// R(t), R the wheel odometry. Such a copy is skipped, counted, and
+  /// starts the next segment; unless odometry_as_logged, the odometry is
+  /// rebuilt by chaining the logged increments within each segment, in
+  /// log order (timestamps that run backwards included).
+  bool reanchored = false;
 };
 
 /// The angular step CARMEN's FLASER/RLASER imply for `num_beams`, degrees:
@@ -100,6 +114,9 @@ double CarmenDefaultStepDeg(int num_beams);
 /// message whose timestamp is <= 0 or not after the previous one of its kind
 /// (the corrected logs' pose lines, corrupt stamps) is skipped and counted.
 CarmenLog ReadCarmenLog(const std::string& path, const CarmenReadOptions& options = {});
+
+/// The whitespace-separated fields of one line of a text log.
+std::vector<std::string> SplitLogFields(const std::string& line);
 
 /// The skip counts of `log` as one line each ("NEFF: not read: 910 lines").
 std::vector<std::string> SkipReport(const CarmenLog& log);

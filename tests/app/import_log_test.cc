@@ -212,6 +212,50 @@ TEST(ImportLogTest, ReferenceIsWrittenScoredAndDrawn) {
   EXPECT_EQ(image.height, 200);
 }
 
+// A BreezySLAM log (found by its shape) of the rover driving straight
+// through the room: 400 ticks a line on both wheels, the Hokuyo 0.145 m
+// ahead of the axle. Both filters map the walls and end on the odometry.
+TEST(ImportLogTest, BreezySlamLogRunsBothFilters) {
+  const std::string dir = FreshDir("breezyslam");
+  const double step_m = 0.077 * 2.0 * kPi / 2000.0 * 400.0;
+  std::ostringstream log;
+  for (int k = 0; k < 25; ++k) {
+    log << 5000000 + 100000 * k << " 0 " << 1000 + 400 * k << ' ' << 7000 + 400 * k;
+    for (int i = 4; i < 24; ++i) log << " 0";
+    const Eigen::Vector2d laser(-1.0 + step_m * k + 0.145, -0.5);
+    for (int b = 0; b < 682; ++b) {
+      const double bearing = (-120.0 + b * 240.0 / 681.0) * kPi / 180.0;
+      log << ' ' << std::lround(1000.0 * RoomRange(laser, bearing));
+    }
+    log << " 0\n";
+  }
+  const std::string path = dir + ".dat";
+  std::ofstream(path) << log.str();
+  ImportOptions options = Options(path, dir);
+  options.read.max_range_m = 20.0;  // the room is larger than the URG's 4 m
+  const ImportReport report = ImportLog(RealConfig(), options);
+  EXPECT_EQ(report.laser, realdata::kBreezySlamLaser);
+  EXPECT_EQ(report.num_beams, 682);
+  EXPECT_EQ(report.num_scans, 25);
+  EXPECT_FALSE(report.has_reference);
+  const nlohmann::json manifest = rundir::ReadManifest(dir);
+  EXPECT_EQ(manifest["laser_offset_m"], 0.145);
+  for (const std::string& name : rundir::FilterNames()) {
+    int lines = 0;
+    for (const MapFeature& f : rundir::ReadMapCsv(rundir::PathIn(dir, rundir::MapFile(name)))) {
+      lines += f.type == FeatureType::kLine ? 1 : 0;
+    }
+    EXPECT_GE(lines, 3) << name;
+  }
+  const rundir::CsvTable trajectory = rundir::ReadCsv(rundir::PathIn(dir, rundir::kTrajectoryFile));
+  const std::vector<double>& last = trajectory.rows.back();
+  const int odom_x = 4, classical_x = 10;
+  // The log's odometry frame: the first line at the origin; frame R 0.2 m ahead.
+  EXPECT_NEAR(last[odom_x], 24 * step_m + 0.2, 1e-9);
+  EXPECT_NEAR(last[classical_x], last[odom_x], 0.02);
+  EXPECT_NEAR(last[classical_x + 1], last[odom_x + 1], 0.02);
+}
+
 TEST(ImportLogTest, BadLogsAreErrorsNamingTheFile) {
   const std::string dir = FreshDir("bad");
   const std::string only_odometry = dir + "_odom.log";

@@ -192,6 +192,75 @@ TEST(CarmenLogTest, TimestampsThatDoNotIncreaseAreCountedSkips) {
   EXPECT_EQ(SkipReport(log).size(), 2u);
 }
 
+// An ODOM line in CARMEN's format at `pose`, time `t`.
+std::string OdomLine(const Pose2& pose, double t) {
+  std::ostringstream out;
+  out.precision(17);
+  out << "ODOM " << pose.x << ' ' << pose.y << ' ' << pose.theta << " 0 0 0 " << t << " h " << t
+      << '\n';
+  return out.str();
+}
+
+// A corrected log restarts its odometry at each scan's corrected pose C:
+// after the scan (and its ODOM copy of C), the ODOM lines are C (+) the wheel
+// odometry's motion since the scan. The wheel odometry is rebuilt from the
+// increments, in log order, the line whose timestamp runs backwards included.
+TEST(CarmenLogTest, OdometryRestartedAtEachScanIsRebuilt) {
+  const Pose2 corrected(1.1, 0.1, 0.1);
+  std::ostringstream laser_poses;
+  laser_poses.precision(17);
+  for (int k = 0; k < 2; ++k) {
+    laser_poses << corrected.x << ' ' << corrected.y << ' ' << corrected.theta << (k ? "" : " ");
+  }
+  // Wheel odometry: (0,0,0) at t=1, (1,0,0) at the scan (t=2), then (1,0,0.5),
+  // (1,0,0) and (1,0,0) more, each in the robot's frame.
+  const Pose2 at3 = corrected * Pose2(1, 0, 0.5);
+  const Pose2 at29 = at3 * Pose2(1, 0, 0);
+  const Pose2 at4 = at29 * Pose2(1, 0, 0);
+  std::string text = OdomLine(Pose2(0, 0, 0), 1.0) + OdomLine(Pose2(1, 0, 0), 2.0) +
+                     Flaser("FLASER", 180, 2.0, laser_poses.str()) +
+                     OdomLine(corrected, 0.0) + "NEFF 10\n" + OdomLine(at3, 3.0) +
+                     OdomLine(at29, 2.9) + OdomLine(at4, 4.0);
+  const std::string path = WritePlain("restarted.log", text);
+  const CarmenLog log = ReadCarmenLog(path);
+  EXPECT_TRUE(log.reanchored);
+  EXPECT_EQ(log.skipped.at("ODOM: the scan's corrected pose (restarts the logged odometry)"), 1);
+  EXPECT_EQ(log.skipped.at("ODOM: timestamp not after the previous one"), 1);
+  ASSERT_EQ(log.odometry.size(), 4u);
+  const LaserMessage& scan = log.lasers.at("FLASER").at(0);
+  EXPECT_TRUE(scan.has_odometry_at_scan);
+  EXPECT_EQ(scan.odometry_at_scan.x, 1.0);
+  // By hand: (1,0,0) (+) (1,0,0.5) = (2, 0, 0.5); then 2 m ahead at 0.5 rad.
+  EXPECT_NEAR(log.odometry[2].pose.x, 2.0, 1e-12);
+  EXPECT_NEAR(log.odometry[2].pose.y, 0.0, 1e-12);
+  EXPECT_NEAR(log.odometry[2].pose.theta, 0.5, 1e-12);
+  EXPECT_NEAR(log.odometry[3].pose.x, 2.0 + 2.0 * std::cos(0.5), 1e-12);
+  EXPECT_NEAR(log.odometry[3].pose.y, 2.0 * std::sin(0.5), 1e-12);
+  EXPECT_NEAR(log.odometry[3].pose.theta, 0.5, 1e-12);
+
+  // As logged: the poses of the lines themselves.
+  CarmenReadOptions as_logged;
+  as_logged.odometry_as_logged = true;
+  const CarmenLog logged = ReadCarmenLog(path, as_logged);
+  EXPECT_TRUE(logged.reanchored);
+  ASSERT_EQ(logged.odometry.size(), 4u);
+  EXPECT_EQ(logged.odometry[3].pose.x, at4.x);
+  EXPECT_EQ(logged.odometry[3].pose.y, at4.y);
+}
+
+// A log whose ODOM lines never repeat a scan's pose is read as logged.
+TEST(CarmenLogTest, OrdinaryOdometryIsKeptAsLogged) {
+  const std::string text = OdomLine(Pose2(0.5, 0.25, 0.125), 1.0) +
+                           Flaser("FLASER", 180, 1.5, "9 9 1 9 9 1") +
+                           OdomLine(Pose2(0.75, 0.5, 0.25), 2.0);
+  const CarmenLog log = ReadCarmenLog(WritePlain("ordinary.log", text));
+  EXPECT_FALSE(log.reanchored);
+  ASSERT_EQ(log.odometry.size(), 2u);
+  EXPECT_EQ(log.odometry[1].pose.x, 0.75);
+  EXPECT_EQ(log.odometry[1].pose.y, 0.5);
+  EXPECT_EQ(log.odometry[1].pose.theta, 0.25);
+}
+
 // FLASER beam counts: the step CARMEN implies (or the user's), beam 0 at -90.
 TEST(CarmenLogTest, BeamCountsAndLayouts) {
   struct Case {
