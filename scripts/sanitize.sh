@@ -25,6 +25,8 @@ time cmake --build "$build" -j"$(nproc)" --target mjslam "${tests[@]}" >"$build/
   { tail -60 "$build/sanitize_build.log"; exit 1; }
 
 export ASAN_OPTIONS=halt_on_error=1:detect_leaks=1:abort_on_error=0
+# Leaks inside Debian's libraries (OSMesa), each documented in the file.
+export LSAN_OPTIONS=suppressions=$PWD/scripts/lsan.supp:print_suppressions=0
 export UBSAN_OPTIONS=halt_on_error=1:print_stacktrace=1
 SECONDS=0
 # The unit tests above, by executable (ctest would list the ones not built).
