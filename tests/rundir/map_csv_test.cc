@@ -77,6 +77,12 @@ TEST(MapCsvTest, ImpossibleFeaturesAreErrorsNamingFileLineAndValues) {
       {"0,line,1,4,1e-4,0,1e-4,,,,", ":2: p1: expected a line angle alpha"},
       {"0,corner,1e308,2,0,0,0,,,,", ":2: p0, p1: expected a corner within 1e6 m"},
       {"0,line,1,0,0,0,0,1,1e300,1,2", ":2: ax, ay, bx, by: expected a segment within 1e6 m"},
+      // Ids that no int holds (casting them is undefined behaviour: the
+      // sanitizer build reports a cast made before the check).
+      {"nan,corner,1,2,0,0,0,,,,", ":2: id: expected a whole number in [0, 1e9] (got nan)"},
+      {"1e308,corner,1,2,0,0,0,,,,", ":2: id: expected a whole number in [0, 1e9]"},
+      {"2147483648,corner,1,2,0,0,0,,,,", ":2: id: expected a whole number in [0, 1e9]"},
+      {"1.5,corner,1,2,0,0,0,,,,", ":2: id: expected a whole number in [0, 1e9]"},
   };
   for (const Case& c : cases) {
     std::ofstream(path) << "id,type,p0,p1,c00,c01,c11,ax,ay,bx,by\n" << c.row << "\n";
