@@ -4,7 +4,8 @@ paper's figures.
 
     /usr/bin/python3 scripts/paper_experiments.py [--out runs/paper] [--runs 25] [--jobs 2]
         [--duration S] [--office-runs 10] [--office-duration 600] [--points E ...]
-        [--realisations 100] [--models default paper] [--scale-worlds W ...]
+        [--realisations 100] [--paper-study-realisations K] [--models default paper]
+        [--scale-worlds W ...]
         [--scale-duration S]
 
 Runs, from the repository root, with build/mjslam (build it first), for each model M (the
@@ -20,7 +21,8 @@ published, docs/method.md):
    twice: with the project's Gaussians (2 cm floor on every Gaussian, `mjslam divergence`'s
    defaults) -> DIR/M/divergence_floor.csv, and with the paper's (each estimated feature with
    its own covariance, the truth 1 mm wide: --floor-std 0 --truth-std 0.001) ->
-   DIR/M/divergence_paper.csv.
+   DIR/M/divergence_paper.csv. Each study draws --realisations realisations per #E, the paper's
+   study --paper-study-realisations if given (it costs about six times the floor's per point).
 4. The figures, one PNG each under DIR/figures/ (names below), and DIR/claims.md (the table
    "claim | paper | default model | paper model", also printed) and DIR/claims.json.
 
@@ -199,8 +201,11 @@ def model_results(args, mjslam, model):
     res["corridor_first"] = run_dirs_of(os.path.join(out, "corridor"))[0]
     res["studies"] = {}
     for key, _, options in STUDIES:
+        realisations = args.realisations
+        if key == "paper" and args.paper_study_realisations is not None:
+            realisations = args.paper_study_realisations
         res["studies"][key] = divergence_study(
-            mjslam, office_first, args.points, args.realisations,
+            mjslam, office_first, args.points, realisations,
             os.path.join(out, "divergence_%s.csv" % key), options)
     return res
 
@@ -452,6 +457,9 @@ def main():
                         " ".join(str(p) for p in DEFAULT_POINTS))
     parser.add_argument("--realisations", type=int, default=100,
                         help="realisations per #E of the divergence studies [100]")
+    parser.add_argument("--paper-study-realisations", type=int, default=None,
+                        help="realisations per #E of the study with the paper's Gaussians "
+                        "[--realisations]")
     parser.add_argument("--models", nargs="+", default=["default", "paper"],
                         choices=["default", "paper"], help="configs/M.yaml [default paper]")
     parser.add_argument("--scale-worlds", nargs="*", default=["worlds/office.xml:300"],
