@@ -4,7 +4,8 @@ paper's figures.
 
     /usr/bin/python3 scripts/paper_experiments.py [--out runs/paper] [--runs 25] [--jobs 2]
         [--duration S] [--office-runs 10] [--office-duration 600] [--points E ...]
-        [--realisations 100] [--models default paper] [--scale-worlds W ...]
+        [--realisations 100] [--paper-study-realisations K] [--models default paper]
+        [--scale-worlds W ...]
         [--scale-duration S]
 
 Runs, from the repository root, with build/mjslam (build it first), for each model M (the
@@ -20,7 +21,8 @@ published, docs/method.md):
    twice: with the project's Gaussians (2 cm floor on every Gaussian, `mjslam divergence`'s
    defaults) -> DIR/M/divergence_floor.csv, and with the paper's (each estimated feature with
    its own covariance, the truth 1 mm wide: --floor-std 0 --truth-std 0.001) ->
-   DIR/M/divergence_paper.csv.
+   DIR/M/divergence_paper.csv. Each study draws --realisations realisations per #E, the paper's
+   study --paper-study-realisations if given (it costs about six times the floor's per point).
 4. The figures, one PNG each under DIR/figures/ (names below), and DIR/claims.md (the table
    "claim | paper | default model | paper model", also printed) and DIR/claims.json.
 
@@ -150,6 +152,25 @@ def divergence_study(mjslam, run_dir, points, realisations, out, options):
     return figs.read_divergence(out)
 
 
+def processed_consistency(traj, name):
+    """Pose consistency of one filter pooled over the steps where it processed its record
+    (figs.processed_steps): {"steps", "inside" (x, y, th counts inside 2 sigma), "nees_sum",
+    "nees_steps"}. summary.json counts every step, and under slam.timing realtime a skipped
+    step compares the last processed estimate, of an earlier pose, with the current true pose."""
+    steps = figs.processed_steps(traj, name)
+    inside = [0, 0, 0]
+    nees_sum, nees_steps = 0.0, 0
+    for s in steps:
+        errors = (traj[name + "_x"][s] - traj["true_x"][s], traj[name + "_y"][s] - traj["true_y"][s],
+                  figs.wrap(traj[name + "_th"][s] - traj["true_th"][s]))
+        for k, (e, var) in enumerate(zip(errors, ("pxx", "pyy", "pthth"))):
+            inside[k] += abs(e) <= 2.0 * math.sqrt(max(traj[name + "_" + var][s], 0.0)) + 1e-12
+        if not math.isnan(traj[name + "_nees"][s]):
+            nees_sum += traj[name + "_nees"][s]
+            nees_steps += 1
+    return {"steps": len(steps), "inside": inside, "nees_sum": nees_sum, "nees_steps": nees_steps}
+
+
 def run_metrics(run_dir):
     """Cost, open loop (both counts), map metrics and 2 sigma of one run directory."""
     summary = read_json(os.path.join(run_dir, "summary.json"))
@@ -172,7 +193,8 @@ def run_metrics(run_dir):
                   "scans_processed": s.get("scans_processed"),
                   "scans_skipped": s.get("scans_skipped"),
                   "inside_2sigma": s.get("inside_2sigma", {}), "map": s.get("map", {}),
-                  "num_features": s.get("num_features")}
+                  "num_features": s.get("num_features"),
+                  "processed": processed_consistency(traj, f), "steps": len(traj["t"])}
         # The cost model recomputed from trajectory.csv must give summary.json's figure.
         if s.get("processing_s") is not None and \
                 abs(sum(modelled) - s["processing_s"]) > 1e-6 * max(1.0, s["processing_s"]):
@@ -199,8 +221,11 @@ def model_results(args, mjslam, model):
     res["corridor_first"] = run_dirs_of(os.path.join(out, "corridor"))[0]
     res["studies"] = {}
     for key, _, options in STUDIES:
+        realisations = args.realisations
+        if key == "paper" and args.paper_study_realisations is not None:
+            realisations = args.paper_study_realisations
         res["studies"][key] = divergence_study(
-            mjslam, office_first, args.points, args.realisations,
+            mjslam, office_first, args.points, realisations,
             os.path.join(out, "divergence_%s.csv" % key), options)
     return res
 
@@ -235,6 +260,21 @@ def claim_a(res):
                 anees_ok &= s["verdict"] == "consistent"
         parts.append("%s (%d runs): %s" % (world, res[world]["sweep"]["completed_runs"],
                                            "; ".join(cells)))
+    # Under slam.timing realtime, the same pooled over the steps each filter processed.
+    for world in ("corridor", "office"):
+        runs = res[world + "_runs"]
+        if all(r[f]["processed"]["steps"] == r[f]["steps"] for r in runs for f in FILTERS):
+            continue
+        cells = []
+        for f in FILTERS:
+            steps = sum(r[f]["processed"]["steps"] for r in runs)
+            inside = [sum(r[f]["processed"]["inside"][k] for r in runs) / steps for k in range(3)]
+            nees = (sum(r[f]["processed"]["nees_sum"] for r in runs) /
+                    max(1, sum(r[f]["processed"]["nees_steps"] for r in runs)))
+            cells.append("%s mean NEES %s, 2σ %s/%s/%s (%d of %d steps)" % (
+                f, fmt(nees), fmt(inside[0]), fmt(inside[1]), fmt(inside[2]), steps,
+                sum(r[f]["steps"] for r in runs)))
+        parts.append("%s, the steps each filter processed (realtime): %s" % (world, "; ".join(cells)))
     verdict = "yes" if two_sigma_ok and anees_ok else ("partly" if two_sigma_ok or anees_ok
                                                        else "no")
     return "; ".join(parts), verdict
@@ -382,8 +422,13 @@ def draw_model_figures(res, fig_dir, points_margin_m=0.5):
                            "Fig. 7 of the paper: divergence of each map to the truth against #E, %s"
                            % where)
     nees = figs.read_csv(os.path.join(res["dir"], "corridor", "nees.csv"))
+    # nees.csv (mjslam sweep) averages every step; under realtime a skipped step holds the
+    # estimate of an earlier pose (figs.processed_steps), so say so in the title.
+    stale = any(r[f]["processed"]["steps"] < r[f]["steps"] for r in res["corridor_runs"]
+                for f in FILTERS)
     figs.plot_nees(nees, os.path.join(fig_dir, "anees_corridor_%s.png" % model),
-                   ", %s, corridor loop" % label)
+                   ", %s, corridor loop%s" % (label, ",\nevery step (realtime: skipped steps "
+                                              "compare an earlier estimate)" if stale else ""))
 
 
 # ---------------------------------------------------------------------------------------------
@@ -452,6 +497,9 @@ def main():
                         " ".join(str(p) for p in DEFAULT_POINTS))
     parser.add_argument("--realisations", type=int, default=100,
                         help="realisations per #E of the divergence studies [100]")
+    parser.add_argument("--paper-study-realisations", type=int, default=None,
+                        help="realisations per #E of the study with the paper's Gaussians "
+                        "[--realisations]")
     parser.add_argument("--models", nargs="+", default=["default", "paper"],
                         choices=["default", "paper"], help="configs/M.yaml [default paper]")
     parser.add_argument("--scale-worlds", nargs="*", default=["worlds/office.xml:300"],

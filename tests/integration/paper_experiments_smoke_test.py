@@ -1,6 +1,7 @@
 #!/usr/bin/python3
 """Smoke test of scripts/paper_experiments.py: tiny settings, then checks that the claims table
-has every claim with a verdict under both models and that every figure is a PNG.
+has every claim with a verdict under both models, that every figure is a PNG, and that the
+study with the paper's Gaussians drew its own number of realisations.
 
     /usr/bin/python3 tests/integration/paper_experiments_smoke_test.py SOURCE_DIR MJSLAM
 
@@ -24,7 +25,7 @@ def main(source_dir, mjslam):
                    "--out", out, "--mjslam", mjslam, "--runs", "2", "--jobs", "2",
                    "--duration", "8", "--office-runs", "1", "--office-duration", "8",
                    "--points", "100", "20000", "25000", "--realisations", "2",
-                   "--scale-duration", "8"]
+                   "--paper-study-realisations", "1", "--scale-duration", "8"]
         result = subprocess.run(command, cwd=source_dir, capture_output=True, text=True)
         problems = []
         if result.returncode != 0:
@@ -46,6 +47,18 @@ def main(source_dir, mjslam):
             with open(path, "rb") as f:
                 if f.read(8) != b"\x89PNG\r\n\x1a\n":
                     problems.append("not a PNG: %s" % name)
+        # --paper-study-realisations: one realisation has variance 0, two almost never.
+        for model in ("default", "paper"):
+            for study, single in (("floor", False), ("paper", True)):
+                path = os.path.join(out, model, "divergence_%s.csv" % study)
+                if not os.path.exists(path):
+                    problems.append("missing %s" % path)
+                    continue
+                with open(path) as f:
+                    variances = [float(row.split(",")[3]) for row in f.read().splitlines()[1:]]
+                if single != all(v == 0.0 for v in variances):
+                    problems.append("%s: variances %s, expected %s realisation(s)" % (
+                        path, variances[:4], 1 if single else 2))
         for p in problems:
             print(p)
         print("%d problems" % len(problems))
