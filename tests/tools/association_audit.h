@@ -27,8 +27,8 @@ namespace mjslam::testing {
 
 /// What AuditAssociations found; the counts are per 50 s of simulated time.
 struct AssociationAudit {
-  /// Line observations matched to a feature made from another line (the
-  /// back face of a thin wall, 0.15 m away, in the maze).
+  /// Line observations matched to a feature made from another true line
+  /// (none in the maze runs of docs/results.md, "The maze map loss").
   std::map<int, int> wrong_matches;
   /// New line features for a true line that already has one.
   std::map<int, int> duplicates;
