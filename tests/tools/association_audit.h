@@ -21,7 +21,9 @@
 #include "rundir/csv_reader.h"
 #include "rundir/recording.h"
 #include "slam/ekf_slam.h"
+#include "slam/data_association.h"
 #include "slam/feature_extraction.h"
+#include "slam/innovation_check.h"
 
 namespace mjslam::testing {
 
@@ -44,6 +46,9 @@ struct AssociationAudit {
   double max_replay_difference = 0.0;
   /// Time of the last recorded step.
   double end_t_s = 0.0;
+  /// The run's innovation check (slam.innovation_check) on the replayed
+  /// filter, as `mjslam run` reports it in summary.json.
+  slam::InnovationCheckResult innovation;
   /// Totals over the run.
   int total_wrong_matches() const { return Total(wrong_matches); }
   int total_duplicates() const { return Total(duplicates); }
@@ -198,6 +203,8 @@ inline AssociationAudit AuditAssociations(const std::string& dir, const std::str
   const int recorded_x = trajectory.ColumnIndex(name + "_x");
 
   AssociationAudit audit;
+  slam::InnovationCheck check(config.slam.innovation_check,
+                              slam::ChiSquare2Quantile(config.slam.ekf.gate_probability));
   std::vector<int> birth_face;  // per map feature: the true line it was made from, -1 none
   std::vector<Eigen::Vector2d> birth_sensor;  // per map feature: the true sensor position then
   Twist2 applied;
@@ -213,6 +220,9 @@ inline AssociationAudit AuditAssociations(const std::string& dir, const std::str
     if (record.has_scan) features = slam::ExtractFeatures(record.scan, config.slam.features);
     const int features_before = filter.num_features();
     const slam::StepReport report = filter.Step(record, record.has_scan ? &features : nullptr);
+    check.Add(record.t_s, report.nis_sum, report.num_matched, report.num_observed,
+              check.NearMisses(report.nearest_nis));
+    audit.innovation = check.result();
     audit.max_replay_difference = std::max(
         audit.max_replay_difference, std::abs(filter.X_WR().x - trajectory.rows[i][recorded_x]));
     if (!record.has_scan) continue;
