@@ -21,7 +21,7 @@ struct InnovationCheckParams {
   int sustained_windows = 3;
   /// Near misses: an observation that matched nothing but lies within this
   /// NIS of a map feature of its kind (at or above the gate) is counted as
-  /// one (> 0; 0 turns the near-miss test off). A filter whose pose or map is
+  /// one (>= 0; 0 turns the near-miss test off). A filter whose pose or map is
   /// a few sigma off sees the walls it mapped just outside the gate.
   double near_miss_max_nis = 100.0;
 
