@@ -291,6 +291,10 @@ rundir::RunSummary ClosedLoop::Summary(bool interrupted) const {
     filter.innovation_longest_failed_streak = check.longest_failed_streak;
     filter.innovation_mean_nis = check.mean_nis;
     filter.innovation_inconsistent_since_s = check.inconsistent_since_s;
+    filter.near_miss_windows = check.near_miss_windows;
+    filter.near_miss_failed_windows = check.near_miss_failed_windows;
+    filter.near_miss_fraction = check.near_miss_fraction;
+    filter.near_miss_since_s = check.near_miss_since_s;
     summary.filters.push_back(filter);
   }
   return summary;

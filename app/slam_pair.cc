@@ -78,7 +78,9 @@ void SlamPair::Step(const SensorRecord& record) {
       f.next_free_step = step + f.period_steps;
       f.last_processed_t_s = record.t_s;
       if (record.has_scan) ++f.scans_processed;
-      f.innovation_check.Add(record.t_s, f.report.nis_sum, f.report.num_matched);
+      f.innovation_check.Add(record.t_s, f.report.nis_sum, f.report.num_matched,
+                             f.report.num_observed,
+                             f.innovation_check.NearMisses(f.report.nearest_nis));
     } else {
       // Busy: the scan is lost; with command input the record's command
       // waits for the next prediction.

@@ -40,7 +40,13 @@ nlohmann::json ToJson(const RunSummary& summary) {
           {"failed_windows", f.innovation_failed_windows},
           {"longest_failed_streak", f.innovation_longest_failed_streak},
           {"mean_nis", std::isfinite(f.innovation_mean_nis) ? nlohmann::json(f.innovation_mean_nis)
-                                                            : nlohmann::json(nullptr)}}}};
+                                                            : nlohmann::json(nullptr)},
+          {"near_miss_windows", f.near_miss_windows},
+          {"near_miss_failed_windows", f.near_miss_failed_windows},
+          {"near_miss_fraction", std::isfinite(f.near_miss_fraction)
+                                     ? nlohmann::json(f.near_miss_fraction)
+                                     : nlohmann::json(nullptr)},
+          {"near_miss_since_s", time_or_null(f.near_miss_since_s)}}}};
   }
   return json;
 }

@@ -56,6 +56,13 @@ struct RunSummary {
     int innovation_longest_failed_streak = 0;
     double innovation_mean_nis = 0.0;
     std::optional<double> innovation_inconsistent_since_s;
+    /// Its near-miss test: windows judged and failed, the fraction of all
+    /// observations that were near misses (NaN: none), and the start of the
+    /// first sustained failure of that test (none: never).
+    int near_miss_windows = 0;
+    int near_miss_failed_windows = 0;
+    double near_miss_fraction = 0.0;
+    std::optional<double> near_miss_since_s;
   };
   std::vector<Filter> filters;
 };

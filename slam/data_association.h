@@ -20,6 +20,12 @@ enum class AssociationOutcome {
   /// Neither: inside the gate of a feature taken by a nearer observation, or
   /// between the gate and the new-feature threshold (the duplicate guard).
   kAmbiguous,
+  /// Far from every map feature of its type, like kNew, but no observation
+  /// of its scan matched a map feature: the scan cannot tell new structure
+  /// from an error of the predicted pose, so it is not added
+  /// (EkfParams::new_features_need_match; set by EkfSlam, never by
+  /// AssociateNearestNeighbour).
+  kUnanchored,
 };
 
 /// Data association of one scan.

@@ -240,6 +240,16 @@ void EkfSlam::Predict(const SensorRecord& record, const MotionInput& input) {
   state_.Predict(input, params_.control_point_offset_m);
 }
 
+void EkfSlam::HoldBackUnanchored(Association* association) const {
+  if (state_.num_features() == 0) return;
+  for (const AssociationOutcome outcome : association->outcome) {
+    if (outcome == AssociationOutcome::kMatched) return;
+  }
+  for (AssociationOutcome& outcome : association->outcome) {
+    if (outcome == AssociationOutcome::kNew) outcome = AssociationOutcome::kUnanchored;
+  }
+}
+
 std::vector<MatchedObservation> EkfSlam::SelectMatches(
     const Association& association, const std::vector<Observation>& observations,
     const ScanFeatures& features, StepReport* report, std::vector<int>* matched_observation) const {
@@ -264,6 +274,8 @@ std::vector<MatchedObservation> EkfSlam::SelectMatches(
       matched_observation->push_back(i);
     } else if (association.outcome[i] == AssociationOutcome::kNew) {
       ++report->num_new;
+    } else if (association.outcome[i] == AssociationOutcome::kUnanchored) {
+      ++report->num_unanchored;
     } else {
       ++report->num_ambiguous;
     }
@@ -325,7 +337,8 @@ StepReport EkfSlam::Step(const SensorRecord& record, const ScanFeatures* feature
 
   // Data association against the predicted map, and the matches that correct.
   const Eigen::MatrixXd d2 = MahalanobisDistances(observations);
-  const Association association = AssociateNearestNeighbour(d2, gate_, new_feature_threshold_);
+  Association association = AssociateNearestNeighbour(d2, gate_, new_feature_threshold_);
+  if (params_.new_features_need_match) HoldBackUnanchored(&association);
   report.nearest_nis.assign(report.num_observed, std::numeric_limits<double>::infinity());
   for (int i = 0; i < report.num_observed; ++i) {
     if (association.outcome[i] == AssociationOutcome::kMatched) {

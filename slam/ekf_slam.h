@@ -51,6 +51,10 @@ struct StepReport {
   /// Observations neither matched nor added (lost a contest for a feature,
   /// or between the gate and the new-feature threshold).
   int num_ambiguous = 0;
+  /// Observations far from every feature that were not added because no
+  /// observation of the scan matched (EkfParams::new_features_need_match);
+  /// not counted in num_ambiguous.
+  int num_unanchored = 0;
   /// Sum of the NIS nu^T S^-1 nu of the matched observations (num_matched of
   /// them), each against its feature in the predicted state, before any
   /// correction: the input of InnovationCheck.
@@ -162,6 +166,9 @@ class EkfSlam {
   // Predicts with `input` and keeps the record's odometry pose and command
   // as the reference of the next step.
   void Predict(const SensorRecord& record, const MotionInput& input);
+  // new_features_need_match: when the map holds features and no observation
+  // matched, turns every kNew of `association` into kUnanchored.
+  void HoldBackUnanchored(Association* association) const;
   // The matched observations that correct, with their indices into
   // `observations` in `matched_observation`: all matches except corners
   // whose two lines matched too (unless correct_corners_of_matched_lines).

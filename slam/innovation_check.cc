@@ -1,5 +1,6 @@
 #include "slam/innovation_check.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -29,6 +30,8 @@ std::vector<ParamProblem> InnovationCheckParams::Validate() const {
   check.Require(probability > 0.5 && probability < 1.0, "probability", probability,
                 "a value in (0.5, 1)");
   check.Require(sustained_windows >= 1, "sustained_windows", sustained_windows, "a value >= 1");
+  check.Require(near_miss_max_nis >= 0.0 && std::isfinite(near_miss_max_nis), "near_miss_max_nis",
+                near_miss_max_nis, "a finite value >= 0 (0: off)");
   return check.problems();
 }
 
@@ -48,15 +51,27 @@ double InnovationCheck::TruncatedVariance(double gate) {
 
 InnovationCheck::InnovationCheck(const InnovationCheckParams& params, double gate)
     : params_(params),
+      gate_(gate),
       mean_(TruncatedMean(gate)),
       variance_(TruncatedVariance(gate)),
-      z_(NormalQuantile(params.probability)) {
+      z_(NormalQuantile(params.probability)),
+      miss_probability_(std::exp(-0.5 * gate)) {
   MJSLAM_CHECK(gate > 0.0);
   params_.ValidateOrThrow();
   result_.mean_nis = std::numeric_limits<double>::quiet_NaN();
+  result_.near_miss_fraction = std::numeric_limits<double>::quiet_NaN();
 }
 
-void InnovationCheck::Add(double t_s, double nis_sum, int count) {
+int InnovationCheck::NearMisses(const std::vector<double>& nearest_nis) const {
+  int misses = 0;
+  for (const double nis : nearest_nis) {
+    misses += nis >= gate_ && nis < params_.near_miss_max_nis ? 1 : 0;
+  }
+  return misses;
+}
+
+void InnovationCheck::Add(double t_s, double nis_sum, int count, int num_observed,
+                          int num_near_misses) {
   if (!window_open_) {
     window_open_ = true;
     window_start_s_ = t_s;
@@ -67,34 +82,70 @@ void InnovationCheck::Add(double t_s, double nis_sum, int count) {
   window_sum_ += nis_sum;
   window_count_ += count;
   if (count > 0) ++window_steps_;
+  window_observed_ += num_observed;
+  window_near_misses_ += num_near_misses;
+  if (num_observed > 0) ++window_scans_;
   total_sum_ += nis_sum;
   result_.observations += count;
   if (result_.observations > 0) result_.mean_nis = total_sum_ / result_.observations;
+  total_observed_ += num_observed;
+  total_near_misses_ += num_near_misses;
+  if (total_observed_ > 0) {
+    result_.near_miss_fraction =
+        static_cast<double>(total_near_misses_) / static_cast<double>(total_observed_);
+  }
 }
 
 void InnovationCheck::CloseWindow() {
-  const double sum = window_sum_;
-  const long count = window_count_;
-  const long steps = window_steps_;
+  JudgeNis();
+  if (params_.near_miss_max_nis > 0.0) JudgeNearMisses();
   window_sum_ = 0.0;
   window_count_ = 0;
   window_steps_ = 0;
-  if (count == 0) return;  // nothing to judge
+  window_observed_ = 0;
+  window_near_misses_ = 0;
+  window_scans_ = 0;
+}
+
+void InnovationCheck::JudgeNis() {
+  if (window_count_ == 0) return;  // nothing to judge
   ++result_.windows;
   // The observations of one scan share its pose error: the bound counts
   // scans, not observations, as the independent draws (conservative).
-  const double bound = mean_ + z_ * std::sqrt(variance_ / static_cast<double>(steps));
-  if (sum / static_cast<double>(count) <= bound) {
-    streak_ = 0;
-    return;
+  const double bound = mean_ + z_ * std::sqrt(variance_ / static_cast<double>(window_steps_));
+  const bool failed = window_sum_ / static_cast<double>(window_count_) > bound;
+  if (failed) ++result_.failed_windows;
+  Streak(failed, &streak_, &streak_start_s_);
+  result_.longest_failed_streak = std::max(result_.longest_failed_streak, streak_);
+}
+
+void InnovationCheck::JudgeNearMisses() {
+  if (window_observed_ == 0) return;
+  ++result_.near_miss_windows;
+  const double p0 = miss_probability_;
+  const double bound =
+      p0 + z_ * std::sqrt(p0 * (1.0 - p0) / static_cast<double>(window_scans_));
+  const bool failed = static_cast<double>(window_near_misses_) /
+                          static_cast<double>(window_observed_) > bound;
+  if (failed) ++result_.near_miss_failed_windows;
+  if (Streak(failed, &miss_streak_, &miss_streak_start_s_) && !result_.near_miss_since_s) {
+    result_.near_miss_since_s = miss_streak_start_s_;
   }
-  ++result_.failed_windows;
-  if (streak_ == 0) streak_start_s_ = window_start_s_;
-  ++streak_;
-  if (streak_ > result_.longest_failed_streak) result_.longest_failed_streak = streak_;
-  if (streak_ >= params_.sustained_windows && !result_.inconsistent_since_s) {
-    result_.inconsistent_since_s = streak_start_s_;
+}
+
+bool InnovationCheck::Streak(bool failed, int* streak, double* streak_start_s) {
+  if (!failed) {
+    *streak = 0;
+    return false;
   }
+  if (*streak == 0) *streak_start_s = window_start_s_;
+  ++*streak;
+  if (*streak < params_.sustained_windows) return false;
+  // The earliest start of a sustained streak of either test.
+  if (!result_.inconsistent_since_s || *streak_start_s < *result_.inconsistent_since_s) {
+    result_.inconsistent_since_s = *streak_start_s;
+  }
+  return true;
 }
 
 }  // namespace mjslam::slam

@@ -19,12 +19,18 @@ struct InnovationCheckParams {
   /// The filter is reported inconsistent after this many failing windows in
   /// a row (>= 1).
   int sustained_windows = 3;
+  /// Near misses: an observation that matched nothing but lies within this
+  /// NIS of a map feature of its kind (at or above the gate) is counted as
+  /// one (>= 0; 0 turns the near-miss test off). A filter whose pose or map is
+  /// a few sigma off sees the walls it mapped just outside the gate.
+  double near_miss_max_nis = 100.0;
 
   template <typename Archive>
   void Serialize(Archive* a) {
     a->Visit(MJSLAM_NVP(window_s));
     a->Visit(MJSLAM_NVP(probability));
     a->Visit(MJSLAM_NVP(sustained_windows));
+    a->Visit(MJSLAM_NVP(near_miss_max_nis));
   }
   /// Every out-of-range field, keys relative to this struct.
   std::vector<ParamProblem> Validate() const;
@@ -43,8 +49,18 @@ struct InnovationCheckResult {
   /// many there were.
   double mean_nis = 0.0;
   long observations = 0;
+  /// Windows with observations judged by the near-miss test, those that
+  /// failed, and the fraction of all observations of the run that were near
+  /// misses (NaN: none observed).
+  int near_miss_windows = 0;
+  int near_miss_failed_windows = 0;
+  double near_miss_fraction = 0.0;
+  /// Start time of the first streak of `sustained_windows` windows failing
+  /// the near-miss test (none: never).
+  std::optional<double> near_miss_since_s;
   /// Start time of the first streak of `sustained_windows` failing windows
-  /// (none: the filter stayed consistent with its innovations).
+  /// of either test, the earlier (none: the filter stayed consistent with
+  /// its innovations).
   std::optional<double> inconsistent_since_s;
   /// Whether such a streak happened.
   bool inconsistent() const { return inconsistent_since_s.has_value(); }
@@ -62,14 +78,34 @@ struct InnovationCheckResult {
 /// `probability`). A filter that lost its map or is
 /// overconfident shifts its matched NIS toward the gate, and fails windows
 /// in a row. Windows with no matched observation neither pass nor fail.
+///
+/// The matched NIS alone cannot see a filter that lost its map: a wrong pose
+/// moves the observations of mapped walls out of the gate, and what still
+/// matches has a small NIS. The second, near-miss test counts those: an
+/// observation that matched nothing although a feature of its kind lies
+/// within `near_miss_max_nis` (NIS at or above the gate g). Observed from
+/// a consistent filter, a mapped feature's NIS exceeds g with probability
+/// p0 = e^(-g/2) (0.01 at the 0.99 gate); new structure lies far from every
+/// feature. A window fails when its fraction of near misses among its
+/// observations exceeds p0 + z_p sqrt(p0 (1 - p0) / K), with K its scans
+/// with observations (the observations of a scan share its pose error).
 class InnovationCheck {
  public:
   /// `gate`: the association gate on NIS (> 0), e.g. ChiSquare2Quantile(0.99).
   InnovationCheck(const InnovationCheckParams& params, double gate);
 
   /// Adds one step at time `t_s` (non-decreasing): the sum of the NIS of its
-  /// `count` matched observations.
-  void Add(double t_s, double nis_sum, int count);
+  /// `count` matched observations (no near-miss data: each observation
+  /// counts as matched).
+  void Add(double t_s, double nis_sum, int count) { Add(t_s, nis_sum, count, count, 0); }
+  /// Adds one step with its `num_observed` observations, of which
+  /// `num_near_misses` were near misses (NearMisses).
+  void Add(double t_s, double nis_sum, int count, int num_observed, int num_near_misses);
+
+  /// The near misses among a scan's observations given each one's nearest
+  /// NIS to a map feature of its kind (slam::StepReport::nearest_nis):
+  /// those in [gate, near_miss_max_nis).
+  int NearMisses(const std::vector<double>& nearest_nis) const;
 
   /// The result so far (the open window left out).
   InnovationCheckResult result() const { return result_; }
@@ -80,19 +116,35 @@ class InnovationCheck {
 
  private:
   void CloseWindow();
+  // The two tests of a closed window.
+  void JudgeNis();
+  void JudgeNearMisses();
+  // Updates a streak of failing windows with this window's verdict; when the
+  // streak is sustained, sets inconsistent_since_s (the earliest) and
+  // returns true.
+  bool Streak(bool failed, int* streak, double* streak_start_s);
 
   InnovationCheckParams params_;
+  double gate_;
   double mean_;
   double variance_;
   double z_;
+  double miss_probability_;
   double window_start_s_ = 0.0;
   bool window_open_ = false;
   double window_sum_ = 0.0;
   long window_count_ = 0;
   long window_steps_ = 0;
+  long window_observed_ = 0;
+  long window_near_misses_ = 0;
+  long window_scans_ = 0;
   int streak_ = 0;
   double streak_start_s_ = 0.0;
+  int miss_streak_ = 0;
+  double miss_streak_start_s_ = 0.0;
   double total_sum_ = 0.0;
+  long total_observed_ = 0;
+  long total_near_misses_ = 0;
   InnovationCheckResult result_;
 };
 

@@ -224,6 +224,18 @@ struct EkfParams {
   /// match, the back face too (docs/method.md, departure 5; it does not fix
   /// the maze map loss of docs/results.md).
   bool gate_line_side = true;
+  /// Whether the observations of a scan of which none matched a map feature
+  /// may become new features (when the map holds any). A prediction error of
+  /// a few sigma moves every observation of a scan out of the gate at once;
+  /// added from that pose, they make a second copy of the walls around the
+  /// robot, shifted by the error, which the next scans match and the error
+  /// stays (the maze map loss, docs/results.md). true (default): such a
+  /// scan adds nothing (AssociationOutcome::kUnanchored); the next
+  /// prediction widens the pose's covariance and a later scan matches, or
+  /// adds features once one of its observations matches. false: every
+  /// observation far from the map is added, as in the paper
+  /// (docs/method.md, departure 5).
+  bool new_features_need_match = true;
   /// Whether a corner whose two lines both matched map features in the same
   /// scan also corrects the state. A corner is the intersection of its two
   /// lines, fitted to the same points: correcting with all three counts that
@@ -277,6 +289,7 @@ struct EkfParams {
     a->Visit(MJSLAM_NVP(gate_probability));
     a->Visit(MJSLAM_NVP(new_feature_probability));
     a->Visit(MJSLAM_NVP(gate_line_side));
+    a->Visit(MJSLAM_NVP(new_features_need_match));
     a->Visit(MJSLAM_NVP(correct_corners_of_matched_lines));
     a->Visit(MJSLAM_NVP(corners_from_map_lines));
     a->Visit(MJSLAM_NVP(line_match_max_gap_m));

@@ -26,6 +26,7 @@ void ExpectPaperChoices(const app::RunConfig& config) {
   EXPECT_EQ(ekf.lateral_skid_s, 0.0);
   EXPECT_TRUE(ekf.correct_corners_of_matched_lines);
   EXPECT_FALSE(ekf.corners_from_map_lines);
+  EXPECT_FALSE(ekf.new_features_need_match);
   EXPECT_EQ(ekf.extra_line_rho_std_m, 0.0);
   EXPECT_EQ(ekf.extra_line_alpha_std_rad, 0.0);
   EXPECT_EQ(ekf.extra_corner_range_std_m, 0.0);
@@ -51,6 +52,7 @@ TEST(PaperConfigTest, SetsEveryDepartureWithAKeyToThePapersChoice) {
   EXPECT_GT(defaults.slam.ekf.lateral_slip_std_m_per_rad, 0.0);
   EXPECT_FALSE(defaults.slam.ekf.correct_corners_of_matched_lines);
   EXPECT_TRUE(defaults.slam.ekf.corners_from_map_lines);
+  EXPECT_TRUE(defaults.slam.ekf.new_features_need_match);
   EXPECT_GT(defaults.slam.ekf.command_noise.change_noise_fraction, 0.0);
   EXPECT_NE(defaults.control.pose_source, "odometry");
 }

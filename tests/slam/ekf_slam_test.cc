@@ -393,7 +393,8 @@ TEST(EkfSlamTest, NewCornerIsWhereItsMapLinesMeetAndMovesWithThem) {
 TEST(EkfSlamTest, GatesByMahalanobisDistanceWithADuplicateGuard) {
   // Known pose, no motion: S_rho = 2 kRhoStd^2 for the second look at the
   // wall, so d2 = (offset / kRhoStd)^2 / 2. Gate 9.21 (99 %), new-feature
-  // threshold 18.4 (99.99 %).
+  // threshold 18.4 (99.99 %). The scan holds this one line, so the rule
+  // that a scan matching nothing adds nothing is off here (tested below).
   struct Case {
     double offset_sigmas;
     int matched;
@@ -401,7 +402,9 @@ TEST(EkfSlamTest, GatesByMahalanobisDistanceWithADuplicateGuard) {
     int added;
   };
   for (const Case& c : {Case{4.0, 1, 0, 0}, Case{5.0, 0, 1, 0}, Case{7.0, 0, 0, 1}}) {
-    EkfSlam filter(EkfParams(), CorrectionMode::kClassical, Pose2(), Pose2());
+    EkfParams params;
+    params.new_features_need_match = false;
+    EkfSlam filter(params, CorrectionMode::kClassical, Pose2(), Pose2());
     ScanFeatures first;
     first.lines.push_back(WallAtTwo(0.0));
     filter.Step(Still(), &first);
@@ -431,10 +434,12 @@ TEST(EkfSlamTest, LineSeenFromTheOtherSideIsAnotherFace) {
   // line x = 2.15, behind it: 0.15 m from the feature's prediction, inside
   // the gate (d2 about 2.2). It is another face of the wall: with
   // gate_line_side (the default) it becomes a new feature; without, it is
-  // matched to the front face and pulls the pose 0.15 m off.
+  // matched to the front face and pulls the pose 0.15 m off. (The scan
+  // holds this one line: new_features_need_match is off to let it be added.)
   for (const bool gate_line_side : {true, false}) {
     EkfParams params;
     params.gate_line_side = gate_line_side;
+    params.new_features_need_match = false;
     params.command_noise.v_noise_std_mps = 0.1;
     params.command_noise.v_noise_fraction = 0.0;
     params.command_noise.change_noise_fraction = 0.0;
@@ -463,21 +468,58 @@ TEST(EkfSlamTest, LineSeenFromTheOtherSideIsAnotherFace) {
   }
 }
 
+TEST(EkfSlamTest, ScanThatMatchesNothingAddsNothing) {
+  // The map holds the wall x = 2. A scan with only the wall y = 3 (far from
+  // it) matched nothing: it cannot tell new structure from a pose error, so
+  // the wall is held back (kUnanchored). The next scan sees both walls: x = 2
+  // matches, and y = 3 is added. Without the rule it is added at once; the
+  // first scan of an empty map is always added.
+  const LineObservation side_wall =
+      Line(3.0, kPi / 2.0, Eigen::Vector2d(-1.0, 3.0), Eigen::Vector2d(1.0, 3.0));
+  for (const bool need_match : {true, false}) {
+    EkfParams params;
+    params.new_features_need_match = need_match;
+    EkfSlam filter(params, CorrectionMode::kClassical, Pose2(), Pose2());
+    ScanFeatures first;
+    first.lines.push_back(WallAtTwo(0.0));
+    EXPECT_EQ(filter.Step(Still(), &first).num_new, 1);
+    ScanFeatures alone;
+    alone.lines.push_back(side_wall);
+    const StepReport held = filter.Step(Still(), &alone);
+    EXPECT_EQ(held.num_unanchored, need_match ? 1 : 0);
+    EXPECT_EQ(held.num_new, need_match ? 0 : 1);
+    EXPECT_EQ(held.num_ambiguous, 0);
+    EXPECT_EQ(held.association.outcome[0],
+              need_match ? AssociationOutcome::kUnanchored : AssociationOutcome::kNew);
+    EXPECT_EQ(filter.num_features(), need_match ? 1 : 2);
+    ScanFeatures both;
+    both.lines.push_back(WallAtTwo(0.0));
+    both.lines.push_back(side_wall);
+    const StepReport anchored = filter.Step(Still(), &both);
+    EXPECT_EQ(anchored.num_matched, need_match ? 1 : 2);
+    EXPECT_EQ(anchored.num_new, need_match ? 1 : 0);
+    EXPECT_EQ(filter.num_features(), 2);
+  }
+}
+
 TEST(EkfSlamTest, MatchesOnlyFeaturesOfTheSameType) {
-  // A corner observation with the very numbers of the line's prediction.
+  // A corner observation with the very numbers of the line's prediction
+  // (seen with the wall, so that the scan matches and may add features).
   EkfSlam filter(EkfParams(), CorrectionMode::kClassical, Pose2(), Pose2());
   ScanFeatures first;
   first.lines.push_back(WallAtTwo(0.0));
   filter.Step(Still(), &first);
   ScanFeatures second;
+  second.lines.push_back(WallAtTwo(0.0));
   second.corners.push_back(Corner(2.0, 0.0));
   const StepReport report = filter.Step(Still(), &second);
-  EXPECT_EQ(report.num_matched, 0);
+  EXPECT_EQ(report.num_matched, 1);  // the wall
+  EXPECT_EQ(report.association.outcome[1], AssociationOutcome::kNew);
   EXPECT_EQ(report.num_new, 1);
   EXPECT_EQ(filter.Map().back().type, MapFeature::Type::kCorner);
   // And a corner matches a corner.
   const StepReport again = filter.Step(Still(), &second);
-  EXPECT_EQ(again.num_matched, 1);
+  EXPECT_EQ(again.num_matched, 2);
   EXPECT_EQ(again.num_new, 0);
 }
 

@@ -1,9 +1,12 @@
 // The innovation consistency check (slam/innovation_check.h) on drawn NIS
 // values: its truncated chi-square moments, quiet on consistent innovations,
-// firing on innovations twice their stated variance.
+// firing on innovations twice their stated variance; its near-miss test quiet
+// on a consistent filter and firing after a pose jump.
 #include "slam/innovation_check.h"
 
 #include <cmath>
+#include <limits>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -73,12 +76,87 @@ TEST(InnovationCheckTest, FiresOnInflatedInnovations) {
   }
 }
 
+// Feeds `seconds` of 10 Hz scans, each with 6 observations of mapped
+// features and 1 of new structure (nearest NIS +inf). From `jump_s` on, the
+// pose is `offset_sigmas` off along one direction of each observation's
+// innovation: its NIS is (offset + n1)^2 + n2^2 with n1, n2 standard normal
+// (0: consistent). Observations under the gate match; the others are near
+// misses when under near_miss_max_nis.
+InnovationCheckResult FeedScans(double offset_sigmas, double jump_s, double seconds,
+                                std::uint64_t seed) {
+  const double gate = ChiSquare2Quantile(0.99);
+  InnovationCheck check(InnovationCheckParams{}, gate);
+  Rng rng(seed);
+  for (int step = 0; step * 0.1 < seconds; ++step) {
+    const double t = step * 0.1;
+    const double offset = t >= jump_s ? offset_sigmas : 0.0;
+    std::vector<double> nearest(7, std::numeric_limits<double>::infinity());
+    double sum = 0.0;
+    int matched = 0;
+    for (int i = 0; i < 6; ++i) {
+      const double n1 = offset + rng.Gaussian(0.0, 1.0);
+      const double n2 = rng.Gaussian(0.0, 1.0);
+      nearest[i] = n1 * n1 + n2 * n2;
+      if (nearest[i] < gate) {
+        sum += nearest[i];
+        ++matched;
+      }
+    }
+    check.Add(t, sum, matched, 7, check.NearMisses(nearest));
+  }
+  return check.result();
+}
+
+TEST(InnovationCheckTest, CountsNearMissesBetweenGateAndLimit) {
+  const double gate = ChiSquare2Quantile(0.99);
+  InnovationCheck check(InnovationCheckParams{}, gate);
+  const double inf = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(check.NearMisses({0.5, 9.0, 9.3, 50.0, 99.9, 100.0, 500.0, inf}), 3);
+}
+
+TEST(InnovationCheckTest, NearMissTestQuietOnAConsistentFilter) {
+  // 20 runs of 600 s (seeds 1..20): a mapped feature's NIS passes the gate
+  // with probability 0.01, the window bound is 0.01 + 3.09 sqrt(0.01 0.99 /
+  // 50) = 0.053 of its observations; three failing windows in a row are
+  // practically impossible.
+  for (std::uint64_t seed = 1; seed <= 20; ++seed) {
+    const InnovationCheckResult result = FeedScans(0.0, 0.0, 600.0, seed);
+    EXPECT_EQ(result.near_miss_windows, 119) << seed;
+    EXPECT_FALSE(result.near_miss_since_s.has_value()) << seed;
+    EXPECT_FALSE(result.inconsistent()) << seed;
+    EXPECT_LE(result.near_miss_failed_windows, 3) << seed;
+    EXPECT_NEAR(result.near_miss_fraction, 6.0 / 7.0 * 0.01, 0.004) << seed;
+  }
+}
+
+TEST(InnovationCheckTest, NearMissTestFiresAfterAPoseJump) {
+  // At t = 60 s the pose jumps 4 sigma (in each observation's innovation):
+  // most observations of mapped walls now miss the gate, and what still
+  // matches has a NIS near the gate's. Every seed is reported by the
+  // near-miss test within three windows of the jump.
+  for (std::uint64_t seed = 1; seed <= 20; ++seed) {
+    const InnovationCheckResult result = FeedScans(4.0, 60.0, 120.0, seed);
+    ASSERT_TRUE(result.near_miss_since_s.has_value()) << seed;
+    EXPECT_GE(*result.near_miss_since_s, 59.9) << seed;
+    EXPECT_LE(*result.near_miss_since_s, 65.1) << seed;
+    EXPECT_TRUE(result.inconsistent()) << seed;
+  }
+  // Off (near_miss_max_nis = 0): no window is judged by it.
+  InnovationCheckParams off;
+  off.near_miss_max_nis = 0.0;
+  InnovationCheck check(off, ChiSquare2Quantile(0.99));
+  for (int step = 0; step < 300; ++step) check.Add(step * 0.1, 0.0, 0, 7, 7);
+  EXPECT_EQ(check.result().near_miss_windows, 0);
+  EXPECT_FALSE(check.result().inconsistent());
+}
+
 TEST(InnovationCheckTest, RejectsBadSettings) {
   InnovationCheckParams params;
   params.window_s = 0.0;
   params.probability = 1.0;
   params.sustained_windows = 0;
-  EXPECT_EQ(params.Validate().size(), 3u);
+  params.near_miss_max_nis = -1.0;
+  EXPECT_EQ(params.Validate().size(), 4u);
 }
 
 }  // namespace

@@ -21,14 +21,16 @@
 #include "rundir/csv_reader.h"
 #include "rundir/recording.h"
 #include "slam/ekf_slam.h"
+#include "slam/data_association.h"
 #include "slam/feature_extraction.h"
+#include "slam/innovation_check.h"
 
 namespace mjslam::testing {
 
 /// What AuditAssociations found; the counts are per 50 s of simulated time.
 struct AssociationAudit {
-  /// Line observations matched to a feature made from another line (the
-  /// back face of a thin wall, 0.15 m away, in the maze).
+  /// Line observations matched to a feature made from another true line
+  /// (none in the maze runs of docs/results.md, "The maze map loss").
   std::map<int, int> wrong_matches;
   /// New line features for a true line that already has one.
   std::map<int, int> duplicates;
@@ -44,6 +46,9 @@ struct AssociationAudit {
   double max_replay_difference = 0.0;
   /// Time of the last recorded step.
   double end_t_s = 0.0;
+  /// The run's innovation check (slam.innovation_check) on the replayed
+  /// filter, as `mjslam run` reports it in summary.json.
+  slam::InnovationCheckResult innovation;
   /// Totals over the run.
   int total_wrong_matches() const { return Total(wrong_matches); }
   int total_duplicates() const { return Total(duplicates); }
@@ -65,21 +70,26 @@ inline bool SameLine(const MapFeature& a, const MapFeature& b) {
          std::abs(WrapAngle(a.params.y() - b.params.y())) < 0.01;
 }
 
-// The index of the true line that an observed line (rho, alpha) in W comes
-// from: same direction within 3 deg, rho within 5 cm, its mid-point within
-// 0.5 m of the true segment. -1: none.
-inline int TrueFace(const FeatureMap& truth, double rho, double alpha, const Eigen::Vector2d& mid) {
-  if (rho < 0) {
-    rho = -rho;
-    alpha = WrapAngle(alpha + kPi);
-  }
+// The index of the true line that an observed line comes from: direction
+// (alpha, in W) within 3 deg, the mid-point `mid` of its seen segment (in W)
+// within 5 cm of the true line and within 0.5 m of the true segment's ends;
+// the nearest such. -1: none. The distance is measured at the mid-point, not
+// as a difference of rho: a short line tilted by its fit error by d alpha
+// has its rho moved by about d alpha times its distance along the line from
+// the foot of the origin's perpendicular (0.11 m for 1.3 deg at 5 m), which
+// would pass it for the wall's other face 0.15 m away.
+inline int TrueFace(const FeatureMap& truth, double alpha, const Eigen::Vector2d& mid) {
   int best = -1;
   double best_d = 0.05;
   for (std::size_t k = 0; k < truth.size(); ++k) {
     const MapFeature& f = truth[k];
     if (f.type != FeatureType::kLine) continue;
-    if (std::abs(WrapAngle(alpha - f.params.y())) > 3.0 * kPi / 180.0) continue;
-    const double d = std::abs(rho - f.params.x());
+    const double turn = WrapAngle(alpha - f.params.y());
+    if (std::abs(turn) > 3.0 * kPi / 180.0 && std::abs(WrapAngle(turn + kPi)) > 3.0 * kPi / 180.0) {
+      continue;
+    }
+    const Eigen::Vector2d normal(std::cos(f.params.y()), std::sin(f.params.y()));
+    const double d = std::abs(normal.dot(mid) - f.params.x());
     if (d >= best_d) continue;
     const Eigen::Vector2d ab = f.p_WB - f.p_WA;
     const double length = ab.norm();
@@ -116,6 +126,63 @@ inline SensorRecord RecordOf(const rundir::RecordedStep& step, const app::RunCon
   return record;
 }
 
+// The beams of observed line `observed`, grouped into runs by the true wall
+// face each hits (the nearest true segment), one event line per run.
+inline void DescribePoints(const FeatureMap& truth, const LaserScan& scan, const Pose2& X_WS,
+                           const slam::LineObservation& observed, std::vector<std::string>* out) {
+  int run_face = -2, run_first = 0, run_count = 0;
+  double run_max_d = 0.0;
+  char text[300];
+  auto flush = [&](int last) {
+    if (run_count == 0) return;
+    if (run_face >= 0) {
+      const MapFeature& f = truth[run_face];
+      std::snprintf(text, sizeof(text),
+                    "    beams %d-%d (%d points): true face %d (rho %.3f, alpha %.1f deg, "
+                    "(%.3f, %.3f)-(%.3f, %.3f)), largest distance %.4f m",
+                    run_first, last, run_count, run_face, f.params.x(), f.params.y() * 180.0 / kPi,
+                    f.p_WA.x(), f.p_WA.y(), f.p_WB.x(), f.p_WB.y(), run_max_d);
+    } else {
+      std::snprintf(text, sizeof(text), "    beams %d-%d: no return", run_first, last);
+    }
+    out->emplace_back(text);
+  };
+  for (int b = observed.first_beam; b <= observed.last_beam; ++b) {
+    int face = -1;
+    double best = 1e9;
+    if (scan.has_return[b]) {
+      const double phi = scan.angle_min_rad + b * scan.angle_increment_rad;
+      const Eigen::Vector2d p =
+          X_WS * Eigen::Vector2d(scan.ranges_m[b] * std::cos(phi), scan.ranges_m[b] * std::sin(phi));
+      for (std::size_t k = 0; k < truth.size(); ++k) {
+        const MapFeature& f = truth[k];
+        if (f.type != FeatureType::kLine) continue;
+        const Eigen::Vector2d ab = f.p_WB - f.p_WA;
+        const double s = std::clamp((p - f.p_WA).dot(ab) / ab.squaredNorm(), 0.0, 1.0);
+        const double d = (p - f.p_WA - s * ab).norm();
+        if (d < best) {
+          best = d;
+          face = static_cast<int>(k);
+        }
+      }
+    }
+    if (face != run_face) {
+      flush(b - 1);
+      run_face = face;
+      run_first = b;
+      run_count = 0;
+      run_max_d = 0.0;
+    }
+    ++run_count;
+    run_max_d = std::max(run_max_d, best);
+  }
+  flush(observed.last_beam);
+  const Eigen::Vector2d a = X_WS * observed.p_SA, b = X_WS * observed.p_SB;
+  std::snprintf(text, sizeof(text), "    seen segment (%.3f, %.3f)-(%.3f, %.3f)", a.x(), a.y(),
+                b.x(), b.y());
+  out->emplace_back(text);
+}
+
 }  // namespace audit_detail
 
 /// Audits filter `name` ("classical" or "selective") on run directory `dir`
@@ -136,6 +203,8 @@ inline AssociationAudit AuditAssociations(const std::string& dir, const std::str
   const int recorded_x = trajectory.ColumnIndex(name + "_x");
 
   AssociationAudit audit;
+  slam::InnovationCheck check(config.slam.innovation_check,
+                              slam::ChiSquare2Quantile(config.slam.ekf.gate_probability));
   std::vector<int> birth_face;  // per map feature: the true line it was made from, -1 none
   std::vector<Eigen::Vector2d> birth_sensor;  // per map feature: the true sensor position then
   Twist2 applied;
@@ -151,6 +220,9 @@ inline AssociationAudit AuditAssociations(const std::string& dir, const std::str
     if (record.has_scan) features = slam::ExtractFeatures(record.scan, config.slam.features);
     const int features_before = filter.num_features();
     const slam::StepReport report = filter.Step(record, record.has_scan ? &features : nullptr);
+    check.Add(record.t_s, report.nis_sum, report.num_matched, report.num_observed,
+              check.NearMisses(report.nearest_nis));
+    audit.innovation = check.result();
     audit.max_replay_difference = std::max(
         audit.max_replay_difference, std::abs(filter.X_WR().x - trajectory.rows[i][recorded_x]));
     if (!record.has_scan) continue;
@@ -174,9 +246,7 @@ inline AssociationAudit AuditAssociations(const std::string& dir, const std::str
       int face = -1;
       if (o < static_cast<int>(features.lines.size())) {
         const slam::LineObservation& observed = features.lines[o];
-        const double alpha = WrapAngle(observed.alpha_rad + X_WS.theta);
-        const double rho = observed.rho_m + X_WS.x * std::cos(alpha) + X_WS.y * std::sin(alpha);
-        face = audit_detail::TrueFace(truth, rho, alpha,
+        face = audit_detail::TrueFace(truth, WrapAngle(observed.alpha_rad + X_WS.theta),
                                       X_WS * (0.5 * (observed.p_SA + observed.p_SB)));
       }
       if (outcome == slam::AssociationOutcome::kNew) {
@@ -216,6 +286,7 @@ inline AssociationAudit AuditAssociations(const std::string& dir, const std::str
                         truth[face].params.y() * 180.0 / kPi, k, made.params.x(),
                         made.params.y() * 180.0 / kPi, report.nearest_nis[o], side_then, side_now);
           audit.events.emplace_back(line);
+          audit_detail::DescribePoints(truth, record.scan, X_WS, features.lines[o], &audit.events);
         }
       }
     }

@@ -44,6 +44,16 @@ int main(int argc, char** argv) {
     }
     std::printf("total: %d wrong line matches, %d duplicate line features\n",
                 audit.total_wrong_matches(), audit.total_duplicates());
+    const mjslam::slam::InnovationCheckResult& check = audit.innovation;
+    std::printf("innovation check: %s since %.1f s; NIS test %d of %d windows failed (mean NIS "
+                "%.2f); near-miss test %d of %d windows failed (since %.1f s), %.2f %% of the "
+                "observations near misses\n",
+                check.inconsistent() ? "INCONSISTENT" : "consistent",
+                check.inconsistent() ? *check.inconsistent_since_s : -1.0, check.failed_windows,
+                check.windows, check.mean_nis, check.near_miss_failed_windows,
+                check.near_miss_windows,
+                check.near_miss_since_s ? *check.near_miss_since_s : -1.0,
+                100.0 * check.near_miss_fraction);
   } catch (const std::exception& error) {
     std::fprintf(stderr, "association_trace: %s\n", error.what());
     return 1;

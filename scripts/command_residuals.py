@@ -1,0 +1,53 @@
+#!/usr/bin/env python3
+"""The true heading increments of a run against its commands, normalised by
+the filters' command-noise model, grouped by control periods since the last
+change of the turn command (docs/results.md, "The maze map loss").
+
+    scripts/command_residuals.py RUN_DIR [W_STD W_FRACTION CHANGE_FRACTION]
+
+The defaults are slam.ekf.command_noise's (0.03 rad/s, 0.1, 0.5). Reads
+RUN_DIR/trajectory.csv (t, true_th, cmd_w; the command of row i is held from
+t_i to t_(i+1)). Prints, per period since the change, the steps and those
+beyond 3 and 4 sigma, then each step beyond 3 sigma. Python 3 standard library.
+"""
+import csv
+import math
+import sys
+
+
+def main():
+    if len(sys.argv) not in (2, 5):
+        sys.exit(__doc__)
+    w_std, w_fraction, change_fraction = (0.03, 0.1, 0.5) if len(sys.argv) == 2 else map(
+        float, sys.argv[2:5])
+    with open(sys.argv[1] + "/trajectory.csv") as f:
+        rows = [(float(r["t"]), float(r["true_th"]), float(r["cmd_w"])) for r in csv.DictReader(f)]
+    groups = {}
+    outliers = []
+    since = 99
+    for i in range(2, len(rows)):
+        t, th, _ = rows[i]
+        t_prev, th_prev, w = rows[i - 1]
+        w_before = rows[i - 2][2]
+        dt = t - t_prev
+        since = 0 if w != w_before else since + 1
+        dth = math.remainder(th - th_prev, 2.0 * math.pi)
+        sigma = (w_std + w_fraction * abs(w) + change_fraction * abs(w - w_before)) * dt
+        z = (dth - w * dt) / sigma
+        g = groups.setdefault(min(since, 5), [0, 0, 0])
+        g[0] += 1
+        g[1] += abs(z) > 3.0
+        g[2] += abs(z) > 4.0
+        if abs(z) > 3.0:
+            outliers.append((t, z, since, dth, w * dt))
+    for since, (n, over3, over4) in sorted(groups.items()):
+        label = f"{since}" if since < 5 else "5 or more"
+        print(f"periods since the turn command changed: {label}: {n} steps, "
+              f"{over3} beyond 3 sigma, {over4} beyond 4 sigma")
+    for t, z, since, dth, commanded in outliers:
+        print(f"  t = {t:.1f} s: {z:+.1f} sigma ({since} periods after a change): "
+              f"turned {dth:+.4f} rad, commanded {commanded:+.4f} rad")
+
+
+if __name__ == "__main__":
+    main()
