@@ -71,11 +71,40 @@ class LocalGeoms {
   /// its next call.
   void RestoreContacts(mjModel* m, mjData* d);
 
+  /// The radius around the robot's root at a refresh within which static
+  /// geoms are contact candidates, and how far the root may move before the
+  /// next refresh, metres (see the class comment).
+  double contact_radius_m() const { return contact_radius_m_; }
+  double contact_slack_m() const { return slack_m_; }
+  /// Calls visit(geom) with the model id of each static world geom that can
+  /// collide (contype or conaffinity not 0) whose box lies within
+  /// contact_radius_m() of `p`, in increasing id order (planes and height
+  /// fields are not in the grid: never visited).
+  template <typename Visit>
+  void ForEachContactCandidate(const Eigen::Vector2d& p, const Visit& visit) const {
+    ForEachCandidateBox(p, [&](int id) { visit(static_geom_[id]); });
+  }
+  /// An upper bound on the number of geoms ForEachContactCandidate visits,
+  /// wherever the point: the largest number of colliding geoms listed in
+  /// the block of cells around any cell that a disc of contact_radius_m()
+  /// can reach.
+  int MaxContactCandidates() const { return max_contact_candidates_; }
+
  private:
   // mj_ray's per-geom distance: mesh, height field or primitive (a static
   // primitive at the pose kept at construction, `box` its id; -1 if none).
   mjtNum RayGeom(const mjModel& m, const mjData& d, int geom, int box, const mjtNum pnt[3],
                  const mjtNum vec[3]) const;
+  // Calls visit(id) for each colliding box within contact_radius_m_ of p,
+  // in increasing id order.
+  template <typename Visit>
+  void ForEachCandidateBox(const Eigen::Vector2d& p, const Visit& visit) const {
+    grid_.ForEachNear(p, contact_radius_m_, [&](int id) {
+      if (contype_[id] != 0 || conaffinity_[id] != 0) visit(id);
+    });
+  }
+  // The bound of MaxContactCandidates.
+  int CountMaxContactCandidates() const;
   // Turns box `id`'s contacts and pose computation off or back on.
   void SetActive(mjModel* m, int id, bool active) const;
 
@@ -109,6 +138,7 @@ class LocalGeoms {
   double refresh_x_ = 0.0;
   double refresh_y_ = 0.0;
   std::vector<int> enabled_;
+  int max_contact_candidates_ = 0;
 };
 
 }  // namespace mjslam::sim::internal
