@@ -215,12 +215,11 @@ mjtNum LocalGeoms::CastRay(const mjModel& m, const mjData& d, const mjtNum pnt[3
 }
 
 void LocalGeoms::FilterContacts(mjModel* m, const mjtNum* p_root) {
-  if (filtering_ && std::hypot(p_root[0] - refresh_x_, p_root[1] - refresh_y_) <= slack_m_) {
-    return;
-  }
+  const bool first = !refresh_.done();
+  if (!refresh_.Due(p_root, slack_m_)) return;
   // Off: every static geom and site (the first time) or the geoms enabled
   // until now.
-  if (!filtering_) {
+  if (first) {
     for (int id = 0; id < static_cast<int>(static_geom_.size()); ++id) SetActive(m, id, false);
     for (const int site : static_site_) m->site_sameframe[site] = 1;
   }
@@ -231,9 +230,6 @@ void LocalGeoms::FilterContacts(mjModel* m, const mjtNum* p_root) {
     SetActive(m, id, true);
     enabled_.push_back(id);
   });
-  filtering_ = true;
-  refresh_x_ = p_root[0];
-  refresh_y_ = p_root[1];
 }
 
 void LocalGeoms::RestoreContacts(mjModel* m, mjData* d) {
@@ -250,7 +246,7 @@ void LocalGeoms::RestoreContacts(mjModel* m, mjData* d) {
     std::copy_n(site_xmat_.data() + 9 * k, 9, d->site_xmat + 9 * site);
   }
   enabled_.clear();
-  filtering_ = false;
+  refresh_.Reset();
 }
 
 }  // namespace mjslam::sim::internal

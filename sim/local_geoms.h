@@ -6,6 +6,7 @@
 // the beam, with MuJoCo's own per-geom functions: the answers are MuJoCo's,
 // the cost local. See sim/README.md, "Local contacts and beams".
 
+#include <cmath>
 #include <vector>
 
 #include <mujoco/mujoco.h>
@@ -14,6 +15,31 @@
 #include "sim/scene_model.h"
 
 namespace mjslam::sim::internal {
+
+/// When the contact candidates around the robot must be found again: at the
+/// first call, when forced, and once the robot's root has moved more than a
+/// slack from where they were last found (in the floor plane).
+class ContactRefresh {
+ public:
+  /// Whether a refresh is due at root position `p_root` (x, y) with
+  /// `slack_m`; if so, `p_root` becomes the point of the last refresh.
+  bool Due(const mjtNum* p_root, double slack_m, bool force = false) {
+    if (!force && done_ && std::hypot(p_root[0] - x_, p_root[1] - y_) <= slack_m) return false;
+    done_ = true;
+    x_ = p_root[0];
+    y_ = p_root[1];
+    return true;
+  }
+  /// Forgets the last refresh (the next call is due).
+  void Reset() { done_ = false; }
+  /// Whether there has been a refresh since construction or Reset.
+  bool done() const { return done_; }
+
+ private:
+  bool done_ = false;
+  double x_ = 0.0;
+  double y_ = 0.0;
+};
 
 /// The geoms of a composed scene that mj_ray and mj_collision would look at,
 /// split into the static ones of the world (body welded to the world, not a
@@ -134,9 +160,7 @@ class LocalGeoms {
   // point, the box ids now enabled.
   double contact_radius_m_ = 0.0;
   double slack_m_ = 0.0;
-  bool filtering_ = false;
-  double refresh_x_ = 0.0;
-  double refresh_y_ = 0.0;
+  ContactRefresh refresh_;
   std::vector<int> enabled_;
   int max_contact_candidates_ = 0;
 };

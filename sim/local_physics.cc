@@ -190,13 +190,7 @@ LocalPhysics::LocalPhysics(const Scene& scene, const mjModel& full, const RobotI
 
 void LocalPhysics::Refresh(const mjModel& full, const LocalGeoms& geoms, const mjtNum* p_root,
                            bool force) {
-  if (!force && refreshed_ &&
-      std::hypot(p_root[0] - refresh_x_, p_root[1] - refresh_y_) <= geoms.contact_slack_m()) {
-    return;
-  }
-  refreshed_ = true;
-  refresh_x_ = p_root[0];
-  refresh_y_ = p_root[1];
+  if (!refresh_.Due(p_root, geoms.contact_slack_m(), force)) return;
   // The planes and the walls near the root, in the full model's order.
   candidates_ = planes_;
   geoms.ForEachContactCandidate(Eigen::Vector2d(p_root[0], p_root[1]),

@@ -80,9 +80,7 @@ class LocalPhysics {
   // Full robot geom id minus local robot geom id.
   int robot_geom_offset_ = 0;
   int first_local_robot_geom_ = 0;
-  bool refreshed_ = false;
-  double refresh_x_ = 0.0;
-  double refresh_y_ = 0.0;
+  ContactRefresh refresh_;
   std::vector<int> candidates_;
 };
 
