@@ -1,9 +1,10 @@
 // Benchmarks of the simulator's cost per world (sim/README.md, "Local
 // contacts and beams"): one control period of physics (Advance(0.1), 50
 // steps of 2 ms, the robot turning in place at its start) and one 181-beam
-// scan (CastLaser), each with the local contacts and beams (the default) and
-// with MuJoCo's all-pairs collision and mj_ray (SetLocalWorldGeoms(false)),
-// side by side in one run. Worlds: every worlds/*.xml, plus the files listed
+// scan (CastLaser), each with the local physics model and beams (the
+// default: sim/README.md, "The local physics model") and with MuJoCo's
+// all-pairs collision on the full scene and mj_ray
+// (SetLocalWorldGeoms(false)), side by side in one run. Worlds: every worlds/*.xml, plus the files listed
 // in MJSLAM_BENCH_WORLDS (colon-separated).
 //
 //   build/bench/mjslam_sim_bench --benchmark_min_time=0.2

@@ -114,6 +114,35 @@ LocalGeoms::LocalGeoms(const mjModel& m, const mjData& d, const RobotIndices& id
   }
   slack_m_ = kContactSlackM;
   contact_radius_m_ = reach + world_margin + kContactSlackM + kContactExtraM;
+  max_contact_candidates_ = CountMaxContactCandidates();
+}
+
+int LocalGeoms::CountMaxContactCandidates() const {
+  if (grid_.num_boxes() == 0) return 0;
+  // A disc of the radius around a point in cell c (or outside the grid,
+  // nearest to c) reaches only cells within `reach` cells of c on each axis.
+  const GridLimits& limits = grid_.limits();
+  const int reach = static_cast<int>(std::ceil(contact_radius_m_ / limits.resolution()));
+  std::vector<int> stamp(static_geom_.size(), -1);
+  int most = 0;
+  for (int cy = 0; cy < limits.height(); ++cy) {
+    for (int cx = 0; cx < limits.width(); ++cx) {
+      const int cell = limits.Index(cx, cy);
+      int count = 0;
+      for (int iy = std::max(0, cy - reach); iy <= std::min(limits.height() - 1, cy + reach); ++iy) {
+        for (int ix = std::max(0, cx - reach); ix <= std::min(limits.width() - 1, cx + reach);
+             ++ix) {
+          for (const int* id = grid_.CellBegin(ix, iy); id != grid_.CellEnd(ix, iy); ++id) {
+            if (stamp[*id] == cell || (contype_[*id] == 0 && conaffinity_[*id] == 0)) continue;
+            stamp[*id] = cell;
+            ++count;
+          }
+        }
+      }
+      most = std::max(most, count);
+    }
+  }
+  return most;
 }
 
 mjtNum LocalGeoms::RayGeom(const mjModel& m, const mjData& d, int geom, int box,
@@ -186,26 +215,21 @@ mjtNum LocalGeoms::CastRay(const mjModel& m, const mjData& d, const mjtNum pnt[3
 }
 
 void LocalGeoms::FilterContacts(mjModel* m, const mjtNum* p_root) {
-  if (filtering_ && std::hypot(p_root[0] - refresh_x_, p_root[1] - refresh_y_) <= slack_m_) {
-    return;
-  }
+  const bool first = !refresh_.done();
+  if (!refresh_.Due(p_root, slack_m_)) return;
   // Off: every static geom and site (the first time) or the geoms enabled
   // until now.
-  if (!filtering_) {
+  if (first) {
     for (int id = 0; id < static_cast<int>(static_geom_.size()); ++id) SetActive(m, id, false);
     for (const int site : static_site_) m->site_sameframe[site] = 1;
   }
   for (const int id : enabled_) SetActive(m, id, false);
   // On: those within the radius of the robot's root, with their own values.
   enabled_.clear();
-  grid_.ForEachNear(Eigen::Vector2d(p_root[0], p_root[1]), contact_radius_m_, [&](int id) {
-    if (contype_[id] == 0 && conaffinity_[id] == 0) return;
+  ForEachCandidateBox(Eigen::Vector2d(p_root[0], p_root[1]), [&](int id) {
     SetActive(m, id, true);
     enabled_.push_back(id);
   });
-  filtering_ = true;
-  refresh_x_ = p_root[0];
-  refresh_y_ = p_root[1];
 }
 
 void LocalGeoms::RestoreContacts(mjModel* m, mjData* d) {
@@ -222,7 +246,7 @@ void LocalGeoms::RestoreContacts(mjModel* m, mjData* d) {
     std::copy_n(site_xmat_.data() + 9 * k, 9, d->site_xmat + 9 * site);
   }
   enabled_.clear();
-  filtering_ = false;
+  refresh_.Reset();
 }
 
 }  // namespace mjslam::sim::internal

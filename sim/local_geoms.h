@@ -6,6 +6,7 @@
 // the beam, with MuJoCo's own per-geom functions: the answers are MuJoCo's,
 // the cost local. See sim/README.md, "Local contacts and beams".
 
+#include <cmath>
 #include <vector>
 
 #include <mujoco/mujoco.h>
@@ -14,6 +15,31 @@
 #include "sim/scene_model.h"
 
 namespace mjslam::sim::internal {
+
+/// When the contact candidates around the robot must be found again: at the
+/// first call, when forced, and once the robot's root has moved more than a
+/// slack from where they were last found (in the floor plane).
+class ContactRefresh {
+ public:
+  /// Whether a refresh is due at root position `p_root` (x, y) with
+  /// `slack_m`; if so, `p_root` becomes the point of the last refresh.
+  bool Due(const mjtNum* p_root, double slack_m, bool force = false) {
+    if (!force && done_ && std::hypot(p_root[0] - x_, p_root[1] - y_) <= slack_m) return false;
+    done_ = true;
+    x_ = p_root[0];
+    y_ = p_root[1];
+    return true;
+  }
+  /// Forgets the last refresh (the next call is due).
+  void Reset() { done_ = false; }
+  /// Whether there has been a refresh since construction or Reset.
+  bool done() const { return done_; }
+
+ private:
+  bool done_ = false;
+  double x_ = 0.0;
+  double y_ = 0.0;
+};
 
 /// The geoms of a composed scene that mj_ray and mj_collision would look at,
 /// split into the static ones of the world (body welded to the world, not a
@@ -71,11 +97,40 @@ class LocalGeoms {
   /// its next call.
   void RestoreContacts(mjModel* m, mjData* d);
 
+  /// The radius around the robot's root at a refresh within which static
+  /// geoms are contact candidates, and how far the root may move before the
+  /// next refresh, metres (see the class comment).
+  double contact_radius_m() const { return contact_radius_m_; }
+  double contact_slack_m() const { return slack_m_; }
+  /// Calls visit(geom) with the model id of each static world geom that can
+  /// collide (contype or conaffinity not 0) whose box lies within
+  /// contact_radius_m() of `p`, in increasing id order (planes and height
+  /// fields are not in the grid: never visited).
+  template <typename Visit>
+  void ForEachContactCandidate(const Eigen::Vector2d& p, const Visit& visit) const {
+    ForEachCandidateBox(p, [&](int id) { visit(static_geom_[id]); });
+  }
+  /// An upper bound on the number of geoms ForEachContactCandidate visits,
+  /// wherever the point: the largest number of colliding geoms listed in
+  /// the block of cells around any cell that a disc of contact_radius_m()
+  /// can reach.
+  int MaxContactCandidates() const { return max_contact_candidates_; }
+
  private:
   // mj_ray's per-geom distance: mesh, height field or primitive (a static
   // primitive at the pose kept at construction, `box` its id; -1 if none).
   mjtNum RayGeom(const mjModel& m, const mjData& d, int geom, int box, const mjtNum pnt[3],
                  const mjtNum vec[3]) const;
+  // Calls visit(id) for each colliding box within contact_radius_m_ of p,
+  // in increasing id order.
+  template <typename Visit>
+  void ForEachCandidateBox(const Eigen::Vector2d& p, const Visit& visit) const {
+    grid_.ForEachNear(p, contact_radius_m_, [&](int id) {
+      if (contype_[id] != 0 || conaffinity_[id] != 0) visit(id);
+    });
+  }
+  // The bound of MaxContactCandidates.
+  int CountMaxContactCandidates() const;
   // Turns box `id`'s contacts and pose computation off or back on.
   void SetActive(mjModel* m, int id, bool active) const;
 
@@ -105,10 +160,9 @@ class LocalGeoms {
   // point, the box ids now enabled.
   double contact_radius_m_ = 0.0;
   double slack_m_ = 0.0;
-  bool filtering_ = false;
-  double refresh_x_ = 0.0;
-  double refresh_y_ = 0.0;
+  ContactRefresh refresh_;
   std::vector<int> enabled_;
+  int max_contact_candidates_ = 0;
 };
 
 }  // namespace mjslam::sim::internal

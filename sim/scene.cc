@@ -126,19 +126,24 @@ std::string CompositionXml(const fs::path& world, const fs::path& robot_file) {
 }
 
 // Loads the composed scene through a virtual file named kSceneFileName in
-// the world's directory.
-internal::ModelPtr LoadComposed(const fs::path& world, const std::string& scene_xml,
-                                const std::string& description) {
+// the directory of `beside` (a file path), with `extra_files` (name, text)
+// in the virtual file system too.
+internal::ModelPtr LoadComposed(
+    const fs::path& beside, const std::string& scene_xml, const std::string& description,
+    const std::vector<std::pair<std::string, std::string>>& extra_files = {}) {
   std::unique_ptr<mjVFS, VfsDeleter> vfs(new mjVFS);
   mj_defaultVFS(vfs.get());
-  MJSLAM_CHECK(mj_makeEmptyFileVFS(vfs.get(), kSceneFileName,
-                                   static_cast<int>(scene_xml.size())) == 0);
-  const int file = mj_findFileVFS(vfs.get(), kSceneFileName);
-  MJSLAM_CHECK(file >= 0);
-  std::memcpy(vfs->filedata[file], scene_xml.data(), scene_xml.size());
+  const auto add_file = [&](const std::string& name, const std::string& text) {
+    MJSLAM_CHECK(mj_makeEmptyFileVFS(vfs.get(), name.c_str(), static_cast<int>(text.size())) == 0);
+    const int file = mj_findFileVFS(vfs.get(), name.c_str());
+    MJSLAM_CHECK(file >= 0);
+    std::memcpy(vfs->filedata[file], text.data(), text.size());
+  };
+  add_file(kSceneFileName, scene_xml);
+  for (const auto& [name, text] : extra_files) add_file(name, text);
 
   char error[1024] = "";
-  const std::string scene_path = (world.parent_path() / kSceneFileName).string();
+  const std::string scene_path = (beside.parent_path() / kSceneFileName).string();
   internal::ModelPtr model(mj_loadXML(scene_path.c_str(), vfs.get(), error, sizeof(error)));
   if (model == nullptr) throw SimError("cannot load " + description + ": " + std::string(error));
   return model;
@@ -386,6 +391,20 @@ DataPtr MakeData(const mjModel& model, const char* what) {
   CallMujoco(what, [&] { data = mj_makeData(&model); });
   if (data == nullptr) throw SimError(std::string(what) + ": cannot allocate MuJoCo data");
   return DataPtr(data);
+}
+
+ModelPtr LoadRobotWithWorldXml(const std::string& robot_model_path, const std::string& world_xml,
+                               const std::string& description) {
+  const fs::path robot_file = fs::absolute(robot_model_path).lexically_normal();
+  const std::string world_name = "mjslam_generated_world.xml";
+  const std::string scene_xml = "<mujoco model=\"mjslam_scene\">\n  <include file=\"" +
+                                world_name + "\"/>\n  <include file=\"" +
+                                XmlEscape(robot_file.filename().string()) + "\"/>\n</mujoco>\n";
+  return LoadComposed(robot_file, scene_xml, description, {{world_name, world_xml}});
+}
+
+RobotIndices FindRobotIndices(const mjModel& model, const std::string& robot_context) {
+  return FindRobot(model, robot_context);
 }
 
 std::string GeomLabel(const mjModel& model, int geom) {

@@ -71,6 +71,17 @@ inline Pose2 SitePose(const mjData& data, int site) {
   return Pose2(p[0], p[1], YawOf(data.site_xmat + 9 * site));
 }
 
+/// The robot model at `robot_model_path` composed with a world given as MJCF
+/// text (included first, as Scene includes a world file), compiled. The
+/// world text is a virtual file beside the robot model, so it must not
+/// include files. Throws SimError("cannot load <description>: ...").
+ModelPtr LoadRobotWithWorldXml(const std::string& robot_model_path, const std::string& world_xml,
+                               const std::string& description);
+
+/// The robot's indices in a composed model, found as Scene finds them
+/// (throws SimError naming `robot_context` if a required name is missing).
+RobotIndices FindRobotIndices(const mjModel& model, const std::string& robot_context);
+
 /// "'name'" of a geom, or "#id" when it has no name (for messages).
 std::string GeomLabel(const mjModel& model, int geom);
 

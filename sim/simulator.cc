@@ -10,6 +10,7 @@
 #include "common/angles.h"
 #include "sim/diff_drive.h"
 #include "sim/local_geoms.h"
+#include "sim/local_physics.h"
 #include "sim/scene_model.h"
 
 namespace mjslam::sim {
@@ -87,13 +88,17 @@ struct Simulator::Impl {
   Scene scene;
   SimParams sim;
   RobotParams robot;
+  // The physics being stepped: the full model or the local one (m, d and
+  // the robot's indices in it).
   internal::RobotIndices ids;
-  // The simulator's copy of the scene's model (its options carry the
-  // timestep) and the physics state.
-  internal::ModelPtr model;
-  internal::DataPtr data;
   mjModel* m = nullptr;
   mjData* d = nullptr;
+  // The simulator's copy of the scene's model (its options carry the
+  // timestep) and its data: the full scene (the laser's static poses; the
+  // physics while local_geoms_on is false or no local model is possible).
+  internal::ModelPtr model;
+  internal::DataPtr data;
+  internal::RobotIndices full_ids;
 
   Pose2 X_RS;
   Twist2 command;
@@ -107,6 +112,15 @@ struct Simulator::Impl {
   // their cells); used while local_geoms_on.
   std::optional<internal::LocalGeoms> local_geoms;
   bool local_geoms_on = true;
+  // The local physics model (sim/README.md, "The local physics model"),
+  // when the world allows one; stepped while local_geoms_on.
+  std::optional<internal::LocalPhysics> local_physics;
+  // Why there is none ("" when there is).
+  std::string local_model_problem;
+  bool UsingLocalPhysics() const { return m != model.get(); }
+  // Makes the local model (true) or the full one (false) the one stepped,
+  // carrying the state over.
+  void UseLocalPhysics(bool on);
 
   bool IsRobotGeom(int geom) const { return internal::IsRobotGeom(*m, ids, geom); }
 
@@ -147,8 +161,11 @@ std::string Simulator::Impl::FirstRobotWorldContact() const {
     const int world_geom = robot1 ? contact.geom2 : contact.geom1;
     const int robot_geom = robot1 ? contact.geom1 : contact.geom2;
     if (m->geom_type[world_geom] == mjGEOM_PLANE) continue;
-    return "robot geom " + internal::GeomLabel(*m, robot_geom) + " touches world geom " +
-           internal::GeomLabel(*m, world_geom);
+    const auto label = [this](int geom) {
+      return UsingLocalPhysics() ? internal::GeomLabel(*model, local_physics->FullGeom(geom))
+                                 : internal::GeomLabel(*m, geom);
+    };
+    return "robot geom " + label(robot_geom) + " touches world geom " + label(world_geom);
   }
   return "";
 }
@@ -220,7 +237,11 @@ void Simulator::Impl::Step() {
     d->ctrl[actuator] = applied;
   }
   // Only the world geoms within the robot's reach collide (same contacts).
-  if (local_geoms_on) local_geoms->FilterContacts(m, d->qpos + ids.root_qposadr);
+  if (UsingLocalPhysics()) {
+    local_physics->Refresh(*model, *local_geoms, d->qpos + ids.root_qposadr);
+  } else if (local_geoms_on) {
+    local_geoms->FilterContacts(m, d->qpos + ids.root_qposadr);
+  }
   auto step = [this] { mj_step(m, d); };
   const std::string problem = TrapMujocoErrors(step);
   if (!problem.empty()) {
@@ -238,6 +259,28 @@ void Simulator::Impl::Step() {
       throw SimError(message.str());
     }
   }
+}
+
+void Simulator::Impl::UseLocalPhysics(bool on) {
+  if (on == UsingLocalPhysics()) return;
+  mjModel* from_m = m;
+  mjData* from_d = d;
+  const internal::RobotIndices from_ids = ids;
+  if (on) {
+    local_physics->Refresh(*model, *local_geoms, d->qpos + ids.root_qposadr, /*force=*/true);
+    m = local_physics->model();
+    d = local_physics->data();
+    ids = local_physics->ids();
+  } else {
+    m = model.get();
+    d = data.get();
+    ids = full_ids;
+  }
+  const internal::LocalPhysics& local = *local_physics;
+  const auto to_geom = [on, &local](int geom) {
+    return on ? local.LocalGeom(geom) : local.FullGeom(geom);
+  };
+  internal::CarryState(*from_m, *from_d, from_ids, *m, d, ids, to_geom);
 }
 
 void Simulator::Impl::CheckOnFloor() const {
@@ -267,6 +310,7 @@ Simulator::Simulator(Scene scene, const SimParams& sim, const RobotParams& robot
 
   // The physics: a copy of the scene's model with the timestep, fresh data.
   r.ids = internal::SceneAccess::Robot(r.scene);
+  r.full_ids = r.ids;
   r.model = internal::CopyModel(internal::SceneAccess::Model(r.scene), "starting the physics");
   r.m = r.model.get();
   r.m->opt.timestep = sim.timestep_s;
@@ -276,6 +320,16 @@ Simulator::Simulator(Scene scene, const SimParams& sim, const RobotParams& robot
   mjtByte laser_groups[mjNGROUP];
   LaserGeomGroups(laser_groups);
   r.local_geoms.emplace(*r.m, *r.d, r.ids, laser_groups);
+  r.local_model_problem = internal::LocalPhysics::Unsupported(*r.m, r.ids);
+  if (r.local_model_problem.empty()) {
+    r.local_physics.emplace(r.scene, *r.m, r.ids, *r.local_geoms);
+    r.local_model_problem = r.local_physics->problem();
+    if (r.local_model_problem.empty()) {
+      r.UseLocalPhysics(true);
+    } else {
+      r.local_physics.reset();
+    }
+  }
   r.Settle();
 }
 
@@ -349,8 +403,11 @@ LaserScan Simulator::CastLaser(const LaserParams& laser,
     throw SimError("CastLaser: " + std::to_string(beam_angle_offsets_rad.size()) +
                    " beam angle offsets for " + std::to_string(laser.num_beams) + " beams");
   }
-  const mjModel* m = impl_->m;
-  const mjData* d = impl_->d;
+  // The beams are cast in the full scene (the static poses kept by
+  // LocalGeoms, or mj_ray on the full model while it is the one stepped),
+  // from the laser site of the physics being stepped.
+  const mjModel* m = impl_->model.get();
+  const mjData* d = impl_->data.get();
 
   LaserScan scan;
   scan.t_s = d->time;
@@ -366,7 +423,7 @@ LaserScan Simulator::CastLaser(const LaserParams& laser,
   const internal::LocalGeoms* local =
       impl_->local_geoms_on ? &*impl_->local_geoms : nullptr;
   const Pose2 X_WS = this->X_WS();
-  const mjtNum origin[3] = {X_WS.x, X_WS.y, d->site_xpos[3 * impl_->ids.laser_site + 2]};
+  const mjtNum origin[3] = {X_WS.x, X_WS.y, impl_->d->site_xpos[3 * impl_->ids.laser_site + 2]};
   const double* offsets = beam_angle_offsets_rad.empty() ? nullptr : beam_angle_offsets_rad.data();
   double* ranges = scan.ranges_m.data();
   auto* has_return = scan.has_return.data();
@@ -390,11 +447,17 @@ LaserScan Simulator::CastLaser(const LaserParams& laser,
 }
 
 void Simulator::SetLocalWorldGeoms(bool on) {
-  if (!on && impl_->local_geoms_on) impl_->local_geoms->RestoreContacts(impl_->m, impl_->d);
-  impl_->local_geoms_on = on;
+  Impl& r = *impl_;
+  if (!on && r.local_geoms_on) r.local_geoms->RestoreContacts(r.model.get(), r.data.get());
+  if (r.local_physics) r.UseLocalPhysics(on);
+  r.local_geoms_on = on;
 }
 
 bool Simulator::local_world_geoms() const { return impl_->local_geoms_on; }
+
+bool Simulator::steps_local_model() const { return impl_->UsingLocalPhysics(); }
+
+const std::string& Simulator::local_model_problem() const { return impl_->local_model_problem; }
 
 int Simulator::CountRobotWorldContacts() const { return impl_->CountRobotWorldContacts(); }
 

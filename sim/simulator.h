@@ -113,6 +113,19 @@ class Simulator {
   /// beams"). Can be switched at any time.
   void SetLocalWorldGeoms(bool on);
   bool local_world_geoms() const;
+  /// Whether the physics now steps the local model (sim/README.md, "The
+  /// local physics model"): the robot and, in a pool of slots, only the
+  /// world geoms it can touch before the next refresh, with the same
+  /// contacts in the same order as the full scene, so the same physics bit
+  /// for bit at a cost that does not grow with the world. True while
+  /// local_world_geoms() unless local_model_problem() is not empty; then the
+  /// full scene is stepped with the far geoms' contacts switched off.
+  bool steps_local_model() const;
+  /// Why this world cannot have a local model (empty when it can): a
+  /// colliding static geom that is a mesh or height field or not on the
+  /// world body, explicit <pair> or <exclude>, or a robot that compiles
+  /// differently with the world than alone.
+  const std::string& local_model_problem() const;
 
   /// Number of contacts between robot geoms and world geoms other than
   /// planes (the floor): 0 unless the robot touches an obstacle.

@@ -22,7 +22,7 @@ const std::set<std::string> kCodeFolders = {"common", "config",   "sim",     "sl
 // What each folder may include from the project and from outside.
 struct Rule {
   std::set<std::string> project;  // project folders it may include
-  bool mujoco = false;  // also sim/scene_model.h and sim/local_geoms.h, sim's internal headers with MuJoCo types
+  bool mujoco = false;  // also sim/scene_model.h, sim/local_geoms.h and sim/local_physics.h, sim's internal headers with MuJoCo types
   bool yaml = false;
   bool gl = false;
   bool files_and_printing = true;  // <fstream>, <iostream>
@@ -62,7 +62,7 @@ std::vector<std::string> Violations(const std::string& text, const Rule& rule) {
     if (nested && kCodeFolders.count(top) > 0 && rule.project.count(top) == 0) {
       found.push_back(header);
     } else if ((top == "mujoco" || header == "sim/scene_model.h" ||
-                header == "sim/local_geoms.h") &&
+                header == "sim/local_geoms.h" || header == "sim/local_physics.h") &&
                !rule.mujoco) {
       found.push_back(header);
     } else if (top == "yaml-cpp" && !rule.yaml) {
@@ -89,6 +89,7 @@ TEST(LayeringTest, DetectsForbiddenIncludes) {
   const std::string internal = "#include \"sim/scene_model.h\"\n#include \"sim/scene.h\"\n";
   EXPECT_EQ(Violations(internal, RuleFor("app")).size(), 1u);
   EXPECT_EQ(Violations("#include \"sim/local_geoms.h\"\n", RuleFor("app")).size(), 1u);
+  EXPECT_EQ(Violations("#include \"sim/local_physics.h\"\n", RuleFor("app")).size(), 1u);
   EXPECT_TRUE(Violations(internal, RuleFor("renders")).empty());
   // rundir/ may write files but knows nothing of MuJoCo, YAML, the filters
   // or the program.

@@ -43,8 +43,10 @@ std::vector<Eigen::Vector2d> ClutterStations() {
 // a geom whose material is invisible, a geom in group 4, a geom that does not
 // collide, and geoms on a static child body. None within 1.2 m of a station.
 // `upright`: boxes and cylinders only, standing on the floor, turned about z
-// only (the robot can run into them without climbing).
-std::string ClutterWorld(std::uint64_t seed, bool upright = false) {
+// only (the robot can run into them without climbing). `child_bodies`: with
+// the static child bodies (without them, the world gets a local physics
+// model: sim/local_physics.h).
+std::string ClutterWorld(std::uint64_t seed, bool upright = false, bool child_bodies = true) {
   Rng rng(seed);
   const std::vector<Eigen::Vector2d> stations = ClutterStations();
   std::ostringstream xml;
@@ -78,14 +80,15 @@ std::string ClutterWorld(std::uint64_t seed, bool upright = false) {
       default: break;
     }
     xml << "/>\n";
-    if (placed % 50 == 7) {
+    if (child_bodies && placed % 50 == 7) {
       xml << "<body pos=\"" << p.x() << " " << p.y() << " 0.5\" euler=\"0 0 33\">"
           << "<geom type=\"box\" size=\"0.3 0.1 0.4\" pos=\"0.2 0.1 0\" euler=\"0 0 20\"/></body>\n";
     }
     ++placed;
   }
   xml << "</worldbody>\n</mujoco>\n";
-  return WriteTempFile("clutter_" + std::to_string(seed) + (upright ? "_upright" : "") + ".xml",
+  return WriteTempFile("clutter_" + std::to_string(seed) + (upright ? "_upright" : "") +
+                           (child_bodies ? "" : "_flat") + ".xml",
                        xml.str());
 }
 
@@ -177,12 +180,15 @@ TEST_F(LocalGeomsTest, EveryBeamInASeededClutterOfEveryGeomTypeAgreesWithMjRay) 
 // (1.5 s forward at 0.8 m/s, a stop, 0.3 s back, random turn rates: the robot runs into
 // things many times, from a distance): the same state after every control
 // step, bit for bit, and the same contacts.
-TEST_F(LocalGeomsTest, LocalContactsGiveBitIdenticalPhysicsThroughCrashes) {
-  const std::string world = ClutterWorld(3, /*upright=*/true);
+// With `child_bodies` the world has no local physics model (the full scene
+// with far contacts off is stepped); without, the local model is.
+void ExpectBitIdenticalThroughCrashes(bool child_bodies) {
+  const std::string world = ClutterWorld(3, /*upright=*/true, child_bodies);
   const Scene scene(world, RobotModelPath());
   Simulator local(scene, SimParams{}, RobotParams{});
   Simulator brute(scene, SimParams{}, RobotParams{});
   brute.SetLocalWorldGeoms(false);
+  ASSERT_EQ(local.steps_local_model(), !child_bodies) << local.local_model_problem();
   Rng rng(5);
   int crashes = 0;
   bool in_contact = false;
@@ -204,6 +210,14 @@ TEST_F(LocalGeomsTest, LocalContactsGiveBitIdenticalPhysicsThroughCrashes) {
   // The drive did run into obstacles, many times.
   EXPECT_GE(crashes, 15);
   std::cout << crashes << " crashes in 500 control steps\n";
+}
+
+TEST_F(LocalGeomsTest, LocalContactsGiveBitIdenticalPhysicsThroughCrashes) {
+  ExpectBitIdenticalThroughCrashes(/*child_bodies=*/true);
+}
+
+TEST_F(LocalGeomsTest, TheLocalPhysicsModelGivesBitIdenticalPhysicsThroughCrashes) {
+  ExpectBitIdenticalThroughCrashes(/*child_bodies=*/false);
 }
 
 // Head on (and at 30 degrees) into an axis-aligned wall at 1.2 m/s, from
