@@ -1,5 +1,7 @@
 #include "app/evaluate.h"
 
+#include <algorithm>
+
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -83,15 +85,23 @@ std::vector<eval::PoseStepMetrics> PoseSteps(const CsvTable& trajectory, const s
   const int truth = trajectory.ColumnIndex("true_x");
   const int estimate = trajectory.ColumnIndex(name + "_x");
   const int pxx = trajectory.ColumnIndex(name + "_pxx");
+  // Realtime timing: a row whose scan the filter skipped holds the estimate
+  // of its last processed row, compared with that row's truth.
+  const auto& columns = trajectory.columns;
+  const bool has_processed =
+      std::find(columns.begin(), columns.end(), name + "_processed") != columns.end();
+  const int processed = has_processed ? trajectory.ColumnIndex(name + "_processed") : -1;
   std::vector<eval::PoseStepMetrics> steps;
+  Pose2 X_WR_true;
   for (const std::vector<double>& row : trajectory.rows) {
+    if (processed < 0 || row[processed] != 0.0 || steps.empty()) {
+      X_WR_true = Pose2(row[truth], row[truth + 1], row[truth + 2]);
+    }
     Eigen::Matrix3d P;
     P << row[pxx], row[pxx + 1], row[pxx + 2], row[pxx + 1], row[pxx + 3], row[pxx + 4],
         row[pxx + 2], row[pxx + 4], row[pxx + 5];
-    steps.push_back(eval::EvaluatePoseStep(Pose2(row[truth], row[truth + 1], row[truth + 2]),
-                                           Pose2(row[estimate], row[estimate + 1],
-                                                 row[estimate + 2]),
-                                           P));
+    steps.push_back(eval::EvaluatePoseStep(
+        X_WR_true, Pose2(row[estimate], row[estimate + 1], row[estimate + 2]), P));
   }
   return steps;
 }

@@ -51,7 +51,9 @@ eval::Map RunGroundTruth(const std::string& run_dir, const eval::GroundTruthPara
 
 /// The pose metrics (error, NEES, inside 2 sigma) of filter `name` at every
 /// row of a trajectory.csv table, from its estimate, covariance and truth
-/// columns.
+/// columns. A row whose scan the filter skipped (realtime timing,
+/// `<name>_processed` 0) holds the estimate of its last processed row and is
+/// compared with that row's true pose.
 std::vector<eval::PoseStepMetrics> PoseSteps(const rundir::CsvTable& trajectory,
                                              const std::string& name);
 

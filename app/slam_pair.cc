@@ -124,9 +124,10 @@ slam::StepReport SlamPair::CatchUpAndStep(Filter* f, int step, const SensorRecor
   return f->filter.Step(since_last, features);
 }
 
-std::vector<rundir::FilterRow> SlamPair::Rows(const Pose2& X_WR_true) const {
+std::vector<rundir::FilterRow> SlamPair::Rows(const Pose2& X_WR_true) {
   std::vector<rundir::FilterRow> rows;
-  for (const Filter& f : filters_) {
+  for (Filter& f : filters_) {
+    if (f.processed) f.X_WR_true_processed = X_WR_true;
     rundir::FilterRow row;
     row.X_WR = f.filter.X_WR();
     row.P = f.filter.pose_covariance();
@@ -138,7 +139,7 @@ std::vector<rundir::FilterRow> SlamPair::Rows(const Pose2& X_WR_true) const {
     row.open_loop_s = f.open_loop_s;
     row.processed = f.processed;
     // Not finite where P is (nearly) singular: the known start and the steps after.
-    row.nees = eval::EvaluatePoseStep(X_WR_true, row.X_WR, row.P).nees;
+    row.nees = eval::EvaluatePoseStep(f.X_WR_true_processed, row.X_WR, row.P).nees;
     rows.push_back(row);
   }
   return rows;

@@ -59,11 +59,13 @@ class SlamPair {
   void Step(const SensorRecord& record);
 
   /// Both filters' columns of trajectory.csv after the last step, in the
-  /// order of rundir::FilterNames(); X_WR_true is the true pose of R for
-  /// the NEES. A filter that skipped the step reports its last processed
-  /// estimate, covariance and map size, 0 matched, updated and microseconds,
-  /// the period still running, and processed = false.
-  std::vector<rundir::FilterRow> Rows(const Pose2& X_WR_true) const;
+  /// order of rundir::FilterNames(); X_WR_true is this step's true pose of R.
+  /// A filter that skipped the step reports its last processed estimate,
+  /// covariance and map size, 0 matched, updated and microseconds, the period
+  /// still running, and processed = false; its NEES compares that estimate
+  /// with the true pose of the step it refers to (its last processed one),
+  /// not with this step's.
+  std::vector<rundir::FilterRow> Rows(const Pose2& X_WR_true);
 
   /// Processing time of filter `i` (0 classical, 1 selective) for the last
   /// step, seconds (ControlParams::processing), and the command period it
@@ -117,6 +119,8 @@ class SlamPair {
     double last_processed_t_s = 0.0;
     std::vector<SensorRecord> skipped_records;
     bool processed = true;
+    // The true pose at the last processed step: what the estimate is of.
+    Pose2 X_WR_true_processed;
     int scans_processed = 0;
     int scans_skipped = 0;
   };

@@ -10,6 +10,7 @@
 #include "app/control.h"
 #include "app/slam_pair.h"
 #include "common/records.h"
+#include "eval/pose_metrics.h"
 #include "slam/slam_params.h"
 
 namespace mjslam::app {
@@ -131,6 +132,34 @@ TEST(SlamPairTest, SkippedStepReportsTheLastProcessedEstimate) {
     EXPECT_EQ(skipped[f].processing_us, 0.0);
     EXPECT_DOUBLE_EQ(skipped[f].period_s, 0.30000000000000004);
   }
+}
+
+// A skipped step's NEES compares the estimate it holds (of its last processed
+// step) with the truth of that step, not with the truth of the step skipped:
+// the row repeats the processed row's NEES, which the current truth would
+// change.
+TEST(SlamPairTest, SkippedStepNeesIsThatOfTheStepItsEstimateIsOf) {
+  const std::vector<SensorRecord> records = StraightRecords(std::vector<double>(12, 0.5));
+  SlamPair pair(Timing("realtime", "command"), ModelCost(0.25), kDt, Pose2(), Pose2(), Rng(1));
+  std::vector<double> processed_nees(2, std::nan(""));
+  int finite_skipped = 0;
+  for (std::size_t k = 0; k < records.size(); ++k) {
+    pair.Step(records[k]);
+    // A truth a little off the commanded path, so that the NEES changes.
+    const Pose2 truth(records[k].X_OR.x + 0.004 * k, 0.002 * k, 0.001 * k);
+    const std::vector<rundir::FilterRow> rows = pair.Rows(truth);
+    for (int f = 0; f < 2; ++f) {
+      if (rows[f].processed) {
+        processed_nees[f] = rows[f].nees;
+        continue;
+      }
+      if (!std::isfinite(processed_nees[f])) continue;
+      ++finite_skipped;
+      EXPECT_EQ(rows[f].nees, processed_nees[f]) << "step " << k << " filter " << f;
+      EXPECT_NE(rows[f].nees, eval::EvaluatePoseStep(truth, rows[f].X_WR, rows[f].P).nees);
+    }
+  }
+  EXPECT_GT(finite_skipped, 4);
 }
 
 // Driving straight with a different command on each step, a filter busy for
