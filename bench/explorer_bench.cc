@@ -4,9 +4,13 @@
 // 2 s of driving (the explorer's replan period) the clearance is brought up
 // to date incrementally (ClearanceField::Update, what the explorer does),
 // recomputed over the whole grid for comparison (ClearanceField::Recompute,
-// what it did before), and the Dijkstra costs of a NavigationMap are built on
-// it. Prints, per 10 m of corridor, the CPU time per call of each, side by
-// side, against the explored area and the grid's size.
+// what it did before), and the path searches of a NavigationMap run on it:
+// the whole Dijkstra (what the explorer did before), the explorer's searches
+// on demand (A* to a goal 6 m back along the drive, as a replan does, and a
+// Dijkstra to a cost of 8 m, the bound a goal choice reaches with a frontier
+// a few metres away). Prints, per 10 m of corridor, the CPU time per call of
+// each and the cells each settles, side by side, against the explored area
+// and the grid's size.
 //
 //   build/bench/mjslam_explorer_bench
 
@@ -43,6 +47,8 @@ constexpr double kStepM = 0.04;
 constexpr double kTurnStepRad = 0.12;
 // Scans between two navigation maps (the 2 s replan period).
 constexpr int kScansPerPlan = 20;
+// Cost bound of the bounded Dijkstra, metres.
+constexpr double kBoundedCostM = 8.0;
 
 // CPU time of this thread, seconds.
 double CpuSeconds() {
@@ -139,11 +145,17 @@ void Run() {
   ClearanceField incremental(ClearanceCapM(params));
   std::printf("Clearance transform per call (every %d scans), CPU ms, same grid, same run\n",
               kScansPerPlan);
-  std::printf("%8s %10s %10s %14s %12s %12s %8s %14s\n", "x_m", "free_m2", "cells",
-              "incremental_ms", "recomputed", "full_ms", "ratio", "dijkstra_ms");
+  std::printf("%8s %10s %10s %14s %12s %12s %8s %14s %10s %10s %10s %11s %10s\n", "x_m",
+              "free_m2", "cells", "incremental_ms", "recomputed", "full_ms", "ratio",
+              "dijkstra_ms", "settled", "astar_ms", "settled", "bounded_ms", "settled");
   double incremental_s = 0.0;
   double full_s = 0.0;
   double dijkstra_s = 0.0;
+  double astar_s = 0.0;
+  double bounded_s = 0.0;
+  double dijkstra_cells = 0.0;
+  double astar_cells = 0.0;
+  double bounded_cells = 0.0;
   double recomputed = 0.0;
   int calls = 0;
   double next_report_x = 10.0;
@@ -163,14 +175,35 @@ void Run() {
     const NavigationMap map(grid, incremental, params, poses[i].translation());
     t1 = CpuSeconds();
     dijkstra_s += t1 - t0;
+    dijkstra_cells += map.settled_cells();
+    // A* back to where the laser was 6 m of driving ago (150 scans).
+    const size_t back = i >= 150 ? i - 150 : 0;
+    t0 = CpuSeconds();
+    NavigationMap astar(grid, incremental, params, poses[i].translation(),
+                        NavigationMap::Search::kOnDemand);
+    astar.SearchTo(grid.CellOf(poses[back].translation()));
+    t1 = CpuSeconds();
+    astar_s += t1 - t0;
+    astar_cells += astar.settled_cells();
+    t0 = CpuSeconds();
+    NavigationMap bounded(grid, incremental, params, poses[i].translation(),
+                          NavigationMap::Search::kOnDemand);
+    bounded.ExpandTo(kBoundedCostM);
+    t1 = CpuSeconds();
+    bounded_s += t1 - t0;
+    bounded_cells += bounded.settled_cells();
     ++calls;
     if (poses[i].x >= next_report_x || i + kScansPerPlan >= poses.size()) {
-      std::printf("%8.1f %10.0f %10d %14.3f %12.0f %12.3f %8.1f %14.3f\n", poses[i].x,
-                  grid.KnownFreeArea(), grid.width() * grid.height(),
+      std::printf("%8.1f %10.0f %10d %14.3f %12.0f %12.3f %8.1f %14.3f %10.0f %10.3f %10.0f %11.3f "
+                  "%10.0f\n",
+                  poses[i].x, grid.KnownFreeArea(), grid.width() * grid.height(),
                   1e3 * incremental_s / calls, recomputed / calls, 1e3 * full_s / calls,
-                  full_s / std::max(incremental_s, 1e-12), 1e3 * dijkstra_s / calls);
+                  full_s / std::max(incremental_s, 1e-12), 1e3 * dijkstra_s / calls,
+                  dijkstra_cells / calls, 1e3 * astar_s / calls, astar_cells / calls,
+                  1e3 * bounded_s / calls, bounded_cells / calls);
       std::fflush(stdout);
       incremental_s = full_s = dijkstra_s = recomputed = 0.0;
+      astar_s = bounded_s = dijkstra_cells = astar_cells = bounded_cells = 0.0;
       calls = 0;
       next_report_x += 10.0;
     }

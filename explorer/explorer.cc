@@ -50,6 +50,8 @@ constexpr double kRecoverySpeedMps = 0.1;
 // In-place turn rate of a recovery that can neither back up nor drive
 // forward, rad/s.
 constexpr double kRecoveryTurnRadps = 0.4;
+// The first cost bound of the search for a goal, metres (then doubled).
+constexpr double kFirstSearchCostM = 4.0;
 
 }  // namespace
 
@@ -148,8 +150,9 @@ bool Explorer::PlanToGoal(const NavigationMap& map, const Pose2& X_WR, double t_
 }
 
 std::vector<Explorer::Candidate> Explorer::ScoreFrontiers(
-    const NavigationMap& map, const std::vector<Eigen::Vector2d>& points, bool* unreachable) {
-  std::vector<Candidate> candidates;
+    NavigationMap& map, const std::vector<Eigen::Vector2d>& points, bool* unreachable) {
+  // The points with gain that are not blacklisted (no search needed).
+  std::vector<Candidate> pending;
   for (const Eigen::Vector2d& p : points) {
     const double gain = InformationGain(grid_, p, params_.gain_radius_m);
     if (gain < params_.min_gain_m2) continue;
@@ -159,20 +162,44 @@ std::vector<Explorer::Candidate> Explorer::ScoreFrontiers(
       continue;
     }
     frontier_points_.push_back(p);
-    Eigen::Vector2d best_W = p;
-    const double best = BestViewpoint(map, p, &best_W);
-    if (!std::isfinite(best)) {
-      *unreachable = true;
-      continue;
-    }
-    if (Blacklisted(best_W, &failed)) {
-      *unreachable = *unreachable || failed;
-      continue;
-    }
-    candidates.push_back({p, best_W, params_.gain_weight_per_m2 * gain - best});
+    pending.push_back({p, p, params_.gain_weight_per_m2 * gain,
+                       static_cast<int>(pending.size())});
   }
-  std::stable_sort(candidates.begin(), candidates.end(),
-                   [](const Candidate& a, const Candidate& b) { return a.score > b.score; });
+  // Their viewpoints' costs: the search grows (doubling its cost bound)
+  // until the best candidate costed cannot be beaten by one still pending,
+  // each of which costs more than the bound, so that a goal near the robot
+  // is found without searching the whole map.
+  std::vector<Candidate> candidates;
+  for (double bound = kFirstSearchCostM; !pending.empty(); bound *= 2.0) {
+    map.ExpandTo(bound);
+    const double reach = map.expanded_cost();
+    std::vector<Candidate> still;
+    for (Candidate& candidate : pending) {
+      const double cost = BestViewpoint(map, candidate.frontier_W, &candidate.goal_W);
+      // Final: every cell not settled costs more than `reach`.
+      const bool known = std::isfinite(cost) && cost <= reach;
+      bool failed = false;
+      if (known && Blacklisted(candidate.goal_W, &failed)) {
+        *unreachable = *unreachable || failed;
+      } else if (known) {
+        candidate.score -= cost;
+        candidates.push_back(candidate);
+      } else if (!std::isfinite(reach)) {
+        *unreachable = true;  // searched everything: no reachable viewpoint
+      } else {
+        still.push_back(candidate);
+      }
+    }
+    pending.swap(still);
+    double best = -std::numeric_limits<double>::infinity();
+    for (const Candidate& c : candidates) best = std::max(best, c.score);
+    double pending_best = -std::numeric_limits<double>::infinity();
+    for (const Candidate& c : pending) pending_best = std::max(pending_best, c.score - reach);
+    if (!candidates.empty() && best >= pending_best) break;
+  }
+  std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) {
+    return a.score != b.score ? a.score > b.score : a.order < b.order;
+  });
   return candidates;
 }
 
@@ -200,7 +227,8 @@ double Explorer::BestViewpoint(const NavigationMap& map, const Eigen::Vector2d& 
 
 void Explorer::ChooseGoal(const Pose2& X_WR, double t_s) {
   clearance_.Update(grid_);
-  const NavigationMap map(grid_, clearance_, params_, AxleOf(X_WR));
+  NavigationMap map(grid_, clearance_, params_, AxleOf(X_WR),
+                    NavigationMap::Search::kOnDemand);
   // The scan's frontier points first, the grid's when none of those will do.
   // `unreachable` records a frontier with gain that failed or has no
   // reachable cell (a frontier only near reached goals does not count: the
@@ -213,6 +241,7 @@ void Explorer::ChooseGoal(const Pose2& X_WR, double t_s) {
     candidates = ScoreFrontiers(map, GlobalFrontierPoints(grid_, params_), &unreachable);
   }
   // The best candidate that a path reaches; the others are blacklisted.
+  // (Every candidate has a settled viewpoint, so a path is always found.)
   for (const Candidate& candidate : candidates) {
     frontier_W_ = candidate.frontier_W;
     goal_W_ = candidate.goal_W;
@@ -299,7 +328,9 @@ bool Explorer::ScanBlocksPath() const {
 
 void Explorer::Replan(const Pose2& X_WR, double t_s) {
   clearance_.Update(grid_);
-  const NavigationMap map(grid_, clearance_, params_, AxleOf(X_WR));
+  // A* to the goal only: the search's cost follows the path, not the map.
+  NavigationMap map(grid_, clearance_, params_, AxleOf(X_WR), NavigationMap::Search::kOnDemand);
+  map.SearchTo(grid_.CellOf(goal_W_));
   const double remaining_before = best_remaining_m_;
   if (PlanToGoal(map, X_WR, t_s)) {
     // Keep the progress clock: a new plan is not progress.

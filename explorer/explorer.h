@@ -98,12 +98,14 @@ class Explorer {
  private:
   enum class Phase { kInitialTurn, kExploring, kFinished };
 
-  // A frontier point with gain, the cell h would view it from, and its score
-  // (gain_weight_per_m2 * gain - cost of that cell).
+  // A frontier point with gain, the cell h would view it from, its score
+  // (gain_weight_per_m2 * gain - cost of that cell), and its place among the
+  // frontier points (ties of the score go to the earlier one).
   struct Candidate {
     Eigen::Vector2d frontier_W;
     Eigen::Vector2d goal_W;
     double score;
+    int order;
   };
 
   // The steps of Step(), in order.
@@ -137,8 +139,10 @@ class Explorer {
   void ChooseGoal(const Pose2& X_WR, double t_s);
   // The frontier points among `points` with gain that are not blacklisted
   // (appended to frontier_points_), scored, best first; sets `unreachable`
-  // when one with gain failed before or has no reachable viewpoint.
-  std::vector<Candidate> ScoreFrontiers(const NavigationMap& map,
+  // when one with gain failed before or has no reachable viewpoint. Grows
+  // `map`'s search only as far as needed to know the best candidate: the
+  // list holds the candidates costed by then (the best among all first).
+  std::vector<Candidate> ScoreFrontiers(NavigationMap& map,
                                         const std::vector<Eigen::Vector2d>& points,
                                         bool* unreachable);
   // The least cost, path cost plus twice the distance, of a comfortable

@@ -65,7 +65,7 @@ double ClearanceCapM(const ExplorerParams& params) {
 }
 
 NavigationMap::NavigationMap(const OccupancyGrid& grid, const ExplorerParams& params,
-                             const Eigen::Vector2d& p_W_start)
+                             const Eigen::Vector2d& p_W_start, Search search)
     : grid_(grid),
       params_(params),
       p_W_start_(p_W_start),
@@ -73,11 +73,12 @@ NavigationMap::NavigationMap(const OccupancyGrid& grid, const ExplorerParams& pa
       own_clearance_(ClearanceCapM(params)),
       clearance_(&own_clearance_.values()) {
   own_clearance_.Recompute(grid_);
-  PlanCosts();
+  Start(search);
 }
 
 NavigationMap::NavigationMap(const OccupancyGrid& grid, const ClearanceField& clearance,
-                             const ExplorerParams& params, const Eigen::Vector2d& p_W_start)
+                             const ExplorerParams& params, const Eigen::Vector2d& p_W_start,
+                             Search search)
     : grid_(grid),
       params_(params),
       p_W_start_(p_W_start),
@@ -88,64 +89,94 @@ NavigationMap::NavigationMap(const OccupancyGrid& grid, const ClearanceField& cl
   MJSLAM_CHECK(clearance.limits().width() == grid.width() &&
                clearance.limits().height() == grid.height() &&
                clearance.limits().origin() == grid.origin());
-  PlanCosts();
+  Start(search);
 }
 
-void NavigationMap::PlanCosts() {
-  const int w = grid_.width();
-  const int h = grid_.height();
-  cost_ = Grid2<double>(grid_.limits(), kInfinity);
-  parent_ = Grid2<int>(grid_.limits(), -1);
-  if (w * h == 0) return;
-  const Grid2<float>& clearance = *clearance_;
-
-  // Dijkstra from the start cell, ties broken by cell index (deterministic).
-  if (!grid_.Contains(start_.x(), start_.y())) return;
-  escape_ = !Comfortable(start_.x(), start_.y());
-  start_clearance_ = clearance[grid_.Index(start_.x(), start_.y())];
-  traversable_ = Grid2<std::uint8_t>(grid_.limits(), 0);
-  for (int iy = 0; iy < h; ++iy) {
-    for (int ix = 0; ix < w; ++ix) traversable_(ix, iy) = TraversableSlow(ix, iy);
+void NavigationMap::Start(Search search) {
+  // Nothing to search from a start outside the grid: every cost infinite.
+  if (!grid_.Contains(start_.x(), start_.y())) {
+    expanded_cost_m_ = kInfinity;
+    return;
   }
-  auto traversable = [&](int ix, int iy) {
-    return grid_.Contains(ix, iy) && traversable_(ix, iy) != 0;
-  };
-  const double r = grid_.resolution();
-  using Entry = std::pair<double, int>;
-  std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> open;
+  escape_ = !Comfortable(start_.x(), start_.y());
+  start_clearance_ = (*clearance_)[grid_.Index(start_.x(), start_.y())];
   const int start_index = grid_.Index(start_.x(), start_.y());
-  cost_[start_index] = 0.0;
-  open.push({0.0, start_index});
-  const int dx[8] = {1, -1, 0, 0, 1, 1, -1, -1};
-  const int dy[8] = {0, 0, 1, -1, 1, -1, 1, -1};
-  while (!open.empty()) {
-    const auto [cost, index] = open.top();
-    open.pop();
-    if (cost > cost_[index]) continue;
-    const Eigen::Vector2i cell = grid_.limits().CellOfIndex(index);
+  nodes_[start_index] = Node{0.0f, -1, false};
+  open_.push_back({0.0, 0.0f, start_index});
+  if (search == Search::kFull) ExpandTo(kInfinity);
+}
+
+bool NavigationMap::SettleNext(int goal) {
+  static constexpr int dx[8] = {1, -1, 0, 0, 1, 1, -1, -1};
+  static constexpr int dy[8] = {0, 0, 1, -1, 1, -1, 1, -1};
+  const double r = grid_.resolution();
+  const Eigen::Vector2i goal_cell =
+      goal >= 0 ? grid_.limits().CellOfIndex(goal) : Eigen::Vector2i::Zero();
+  // A*'s heuristic: the octile distance, a lower bound of every path's cost
+  // (each step costs at least its length), less a little for the float
+  // rounding of the stored costs.
+  auto heuristic = [&](int ix, int iy) {
+    if (goal < 0) return 0.0;
+    const int ax = std::abs(ix - goal_cell.x());
+    const int ay = std::abs(iy - goal_cell.y());
+    return (1.0 - 1e-6) * r * (std::max(ax, ay) + (std::sqrt(2.0) - 1.0) * std::min(ax, ay));
+  };
+  while (!open_.empty()) {
+    std::pop_heap(open_.begin(), open_.end(), std::greater<Open>());
+    const Open top = open_.back();
+    open_.pop_back();
+    Node& node = nodes_.at(top.index);
+    if (node.settled || top.cost > node.cost) continue;  // stale entry
+    node.settled = true;
+    ++settled_;
+    const double cost = node.cost;
+    const Eigen::Vector2i cell = grid_.limits().CellOfIndex(top.index);
     const int ix = cell.x();
     const int iy = cell.y();
     for (int k = 0; k < 8; ++k) {
       const int jx = ix + dx[k];
       const int jy = iy + dy[k];
-      if (!traversable(jx, jy)) continue;
+      if (!Traversable(jx, jy)) continue;
       // Diagonal moves must not cut the corner of a blocked cell.
-      if (k >= 4 && (!traversable(ix + dx[k], iy) || !traversable(ix, iy + dy[k]))) continue;
+      if (k >= 4 && (!Traversable(ix + dx[k], iy) || !Traversable(ix, iy + dy[k]))) continue;
       const int j = grid_.Index(jx, jy);
       const double shortfall =
-          std::max(0.0, params_.preferred_clearance_m - clearance[j]) /
+          std::max(0.0, params_.preferred_clearance_m - (*clearance_)[j]) /
           params_.preferred_clearance_m;
       const double step = (k < 4 ? r : r * std::sqrt(2.0)) *
                           (1.0 + params_.clearance_cost_weight * shortfall);
       // Compared as stored (float): a double compared with its own rounding
       // would re-push a cell at an equal cost, without end.
       const float next = static_cast<float>(cost + step);
-      if (next < cost_[j]) {
-        cost_[j] = next;
-        parent_[j] = index;
-        open.push({cost_[j], j});
+      Node& neighbour = nodes_.try_emplace(j, Node{std::numeric_limits<float>::infinity(), -1,
+                                                   false}).first->second;
+      if (!neighbour.settled && next < neighbour.cost) {
+        neighbour.cost = next;
+        neighbour.parent = top.index;
+        open_.push_back({next + heuristic(jx, jy), next, j});
+        std::push_heap(open_.begin(), open_.end(), std::greater<Open>());
       }
     }
+    return true;
+  }
+  return false;
+}
+
+void NavigationMap::ExpandTo(double max_cost_m) {
+  MJSLAM_CHECK(!searched_to_goal_);
+  while (!open_.empty() && open_.front().priority <= max_cost_m) SettleNext(-1);
+  expanded_cost_m_ = open_.empty() ? kInfinity : std::max(expanded_cost_m_, max_cost_m);
+}
+
+bool NavigationMap::SearchTo(const Eigen::Vector2i& goal) {
+  MJSLAM_CHECK(!searched_to_goal_ && settled_ == 0);
+  searched_to_goal_ = true;
+  if (!grid_.Contains(goal.x(), goal.y()) || open_.empty()) return false;
+  const int goal_index = grid_.Index(goal.x(), goal.y());
+  for (;;) {
+    const auto it = nodes_.find(goal_index);
+    if (it != nodes_.end() && it->second.settled) return true;
+    if (!SettleNext(goal_index)) return false;
   }
 }
 
@@ -159,12 +190,6 @@ double NavigationMap::ClearanceAt(const Eigen::Vector2d& p_W) const {
 }
 
 bool NavigationMap::Traversable(int ix, int iy) const {
-  if (!grid_.Contains(ix, iy)) return false;
-  if (!traversable_.cells().empty()) return traversable_[grid_.Index(ix, iy)] != 0;
-  return TraversableSlow(ix, iy);
-}
-
-bool NavigationMap::TraversableSlow(int ix, int iy) const {
   if (!grid_.Contains(ix, iy)) return false;
   const CellState state = grid_.State(ix, iy);
   if (state == CellState::kOccupied) return false;
@@ -189,7 +214,8 @@ bool NavigationMap::TraversableAt(const Eigen::Vector2d& p_W) const {
 
 double NavigationMap::CostTo(int ix, int iy) const {
   if (!grid_.Contains(ix, iy)) return kInfinity;
-  return cost_[grid_.Index(ix, iy)];
+  const auto it = nodes_.find(grid_.Index(ix, iy));
+  return it != nodes_.end() && it->second.settled ? it->second.cost : kInfinity;
 }
 
 bool NavigationMap::SegmentTraversable(const Eigen::Vector2d& a_W,
@@ -205,7 +231,7 @@ bool NavigationMap::SegmentTraversable(const Eigen::Vector2d& a_W,
 std::vector<Eigen::Vector2i> NavigationMap::CellPath(const Eigen::Vector2i& goal) const {
   std::vector<Eigen::Vector2i> cells;
   if (!std::isfinite(CostTo(goal.x(), goal.y()))) return cells;
-  for (int i = grid_.Index(goal.x(), goal.y()); i >= 0; i = parent_[i]) {
+  for (int i = grid_.Index(goal.x(), goal.y()); i >= 0; i = nodes_.at(i).parent) {
     cells.push_back(grid_.limits().CellOfIndex(i));
   }
   std::reverse(cells.begin(), cells.end());

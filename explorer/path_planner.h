@@ -1,6 +1,7 @@
 #pragma once
 
 #include <cstdint>
+#include <unordered_map>
 #include <vector>
 
 #include <Eigen/Core>
@@ -37,27 +38,56 @@ using Path = std::vector<PathPoint>;
 double ClearanceCapM(const ExplorerParams& params);
 
 /// The grid seen by the planner: the clearance of every cell (a
-/// ClearanceField capped at ClearanceCapM) and the cost to reach every cell
-/// from a start point (Dijkstra, 8-connected, on known-free cells with at
-/// least `clearance_m`; each step costs its length times 1 +
+/// ClearanceField capped at ClearanceCapM) and the cost to reach cells from a
+/// start point (Dijkstra, 8-connected, on known-free cells with at least
+/// `clearance_m`; each step costs its length times 1 +
 /// `clearance_cost_weight` * the shortfall of clearance below
 /// `preferred_clearance_m`, relative). When the start cell itself lacks that
 /// clearance, cells within `escape_radius_m` of the start need only be not
 /// occupied and no closer to an occupied cell than the start, so that a
 /// robot stopped close to a wall can plan its way out.
+///
+/// The search runs on demand and touches only the cells it reaches (their
+/// costs live in a hash table, traversability is read per cell), so that its
+/// cost follows the cells searched, not the grid's size: `Search::kFull`
+/// costs every reachable cell at construction; with `Search::kOnDemand` the
+/// caller runs ExpandTo (Dijkstra up to a cost, resumable) or SearchTo (A* to
+/// one cell, octile distance as the heuristic), not both.
 class NavigationMap {
  public:
+  /// How much the constructor searches.
+  enum class Search {
+    /// Every cell reachable from the start (the whole Dijkstra).
+    kFull,
+    /// Nothing: ExpandTo or SearchTo search what is needed.
+    kOnDemand,
+  };
+
   /// Builds the map of `grid` (which must outlive it) from `p_W_start`,
   /// computing the clearance over the whole grid.
   NavigationMap(const OccupancyGrid& grid, const ExplorerParams& params,
-                const Eigen::Vector2d& p_W_start);
+                const Eigen::Vector2d& p_W_start, Search search = Search::kFull);
   /// The same with a clearance field kept up to date by the caller: it must
   /// be current for `grid` (its limits equal the grid's) with a cap of
   /// ClearanceCapM(params), and outlive the map.
   NavigationMap(const OccupancyGrid& grid, const ClearanceField& clearance,
-                const ExplorerParams& params, const Eigen::Vector2d& p_W_start);
+                const ExplorerParams& params, const Eigen::Vector2d& p_W_start,
+                Search search = Search::kFull);
   NavigationMap(const NavigationMap&) = delete;
   NavigationMap& operator=(const NavigationMap&) = delete;
+
+  /// Dijkstra: settles every reachable cell whose cost is at most
+  /// `max_cost_m` (resumes where the last call stopped). Not after SearchTo.
+  void ExpandTo(double max_cost_m);
+  /// The cost up to which every cell's cost is final (infinity once every
+  /// reachable cell is settled), metres.
+  double expanded_cost() const { return expanded_cost_m_; }
+  /// A*: settles cells until `goal` is settled (its cheapest path found) or
+  /// none is left; true when the goal is reachable. Only on a map built with
+  /// Search::kOnDemand that has not searched yet.
+  bool SearchTo(const Eigen::Vector2i& goal);
+  /// Number of cells settled so far (the search's cost).
+  int settled_cells() const { return settled_; }
 
   const OccupancyGrid& grid() const { return grid_; }
   /// Clearance of a cell, metres (at most ClearanceCapM; 0 outside the
@@ -72,20 +102,39 @@ class NavigationMap {
   /// Whether the cell is known free with at least `clearance_m` (a goal must
   /// be; the escape rule does not apply).
   bool Comfortable(int ix, int iy) const;
-  /// Path cost from the start to the cell, metres (infinity if unreachable).
+  /// Path cost from the start to the cell, metres, once the search has
+  /// settled it; infinity if it is unreachable or not settled yet.
   double CostTo(int ix, int iy) const;
   /// Whether every point of the segment is traversable (sampled at half a cell).
   bool SegmentTraversable(const Eigen::Vector2d& a_W, const Eigen::Vector2d& b_W) const;
-  /// Cells from the start to `goal` (inclusive), empty if unreachable.
+  /// Cells from the start to `goal` (inclusive), empty if not settled.
   std::vector<Eigen::Vector2i> CellPath(const Eigen::Vector2i& goal) const;
   /// The start cell.
   Eigen::Vector2i start_cell() const { return start_; }
 
  private:
-  // Traversable() from the grid and the clearance.
-  bool TraversableSlow(int ix, int iy) const;
-  // The traversable cells and the Dijkstra costs from the start.
-  void PlanCosts();
+  // A cell reached by the search: its cost so far (float, compared as
+  // stored), the linear index of the cell before it (-1: none), settled.
+  struct Node {
+    float cost;
+    int parent;
+    bool settled;
+  };
+  // An entry of the open list: priority (cost, plus the heuristic for A*),
+  // cost when pushed, linear index; ordered by priority, then index.
+  struct Open {
+    double priority;
+    float cost;
+    int index;
+    bool operator>(const Open& other) const {
+      return priority != other.priority ? priority > other.priority : index > other.index;
+    }
+  };
+  // Sets up the start (escape rule, open list) after the constructors.
+  void Start(Search search);
+  // Settles the cheapest open cell and relaxes its neighbours; `goal` >= 0
+  // adds A*'s heuristic toward that linear index. False when none is left.
+  bool SettleNext(int goal);
 
   const OccupancyGrid& grid_;
   ExplorerParams params_;
@@ -97,14 +146,15 @@ class NavigationMap {
   float start_clearance_ = 0.0f;
   // The clearance computed by the first constructor (unused by the second).
   ClearanceField own_clearance_;
-  // Per cell of the grid: clearance, metres (the field's values);
-  // Traversable(), computed once (no cells when the start is outside the
-  // grid); path cost, metres; the linear index of the cell before it on its
-  // cheapest path (-1: none).
+  // Per cell of the grid: clearance, metres (the field's values).
   const Grid2<float>* clearance_;
-  Grid2<std::uint8_t> traversable_;
-  Grid2<double> cost_;
-  Grid2<int> parent_;
+  // The cells reached, by linear index, and the open list.
+  std::unordered_map<int, Node> nodes_;
+  std::vector<Open> open_;
+  double expanded_cost_m_ = 0.0;
+  int settled_ = 0;
+  // Whether SearchTo (A*) has run: ExpandTo's costs would not be final.
+  bool searched_to_goal_ = false;
 };
 
 /// Plans a kinematically feasible path of h from the map's start to

@@ -1,4 +1,6 @@
 #include <cmath>
+#include <limits>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -149,6 +151,103 @@ TEST(PathPlannerTest, PathClearOfPointsDetectsAnObstacleOnThePath) {
   EXPECT_FALSE(PathClearOfPoints(path, 0, {{1.5, 0.2}}, 0.3));
   // Behind the point `from`: ignored.
   EXPECT_TRUE(PathClearOfPoints(path, 40, {{1.5, 0.2}}, 0.3));
+}
+
+// A straight corridor 2 m wide from x = 0 to x = length_m, mapped by scans
+// (4 m laser) every 1 m along its middle, looking both ways.
+OccupancyGrid MappedCorridor(double length_m) {
+  const std::vector<Wall> walls = {{{0, 0}, {length_m, 0}},
+                                   {{length_m, 0}, {length_m, 2}},
+                                   {{length_m, 2}, {0, 2}},
+                                   {{0, 2}, {0, 0}}};
+  OccupancyGrid grid{OccupancyGridSettings{}};
+  testing::KinematicSim::Config config;
+  for (double x = 1.0; x < length_m; x += 1.0) {
+    for (const double heading : {0.0, kPi}) {
+      testing::KinematicSim sim(walls, Pose2(x, 1.0, heading), config);
+      grid.InsertScan(sim.Scan(0.0), sim.X_WR() * config.X_RS);
+    }
+  }
+  return grid;
+}
+
+TEST(NavigationMapTest, SearchesOnDemandGiveTheCostsOfTheWholeSearch) {
+  const ExplorerParams params;
+  const OccupancyGrid grid = MappedLCorridor();
+  const Eigen::Vector2d start(1.0, 1.0);
+  const NavigationMap full(grid, params, start);
+  // Dijkstra to a cost bound: exactly the cells the whole search costs at
+  // most that much, with the same costs.
+  NavigationMap bounded(grid, params, start, NavigationMap::Search::kOnDemand);
+  bounded.ExpandTo(3.0);
+  EXPECT_EQ(bounded.expanded_cost(), 3.0);
+  int inside = 0;
+  for (int iy = 0; iy < grid.height(); ++iy) {
+    for (int ix = 0; ix < grid.width(); ++ix) {
+      const double cost = full.CostTo(ix, iy);
+      if (cost <= 3.0) {
+        ++inside;
+        EXPECT_EQ(bounded.CostTo(ix, iy), cost) << ix << " " << iy;
+      } else {
+        EXPECT_FALSE(std::isfinite(bounded.CostTo(ix, iy))) << ix << " " << iy;
+      }
+    }
+  }
+  EXPECT_EQ(bounded.settled_cells(), inside);
+  EXPECT_GT(full.settled_cells(), 2 * inside);
+  // Resumed to the end: every cost of the whole search.
+  bounded.ExpandTo(std::numeric_limits<double>::infinity());
+  EXPECT_FALSE(std::isfinite(bounded.expanded_cost()));
+  EXPECT_EQ(bounded.settled_cells(), full.settled_cells());
+  // A* to single goals: the least cost, and a path of 8-neighbours that
+  // reaches the goal.
+  for (const Eigen::Vector2d& goal_W :
+       {Eigen::Vector2d(5.0, 7.0), Eigen::Vector2d(3.0, 1.5), Eigen::Vector2d(5.5, 3.0)}) {
+    const Eigen::Vector2i goal = grid.CellOf(goal_W);
+    NavigationMap astar(grid, params, start, NavigationMap::Search::kOnDemand);
+    ASSERT_TRUE(astar.SearchTo(goal));
+    EXPECT_NEAR(astar.CostTo(goal.x(), goal.y()), full.CostTo(goal.x(), goal.y()),
+                1e-5 * full.CostTo(goal.x(), goal.y()));
+    EXPECT_LT(astar.settled_cells(), full.settled_cells());
+    const std::vector<Eigen::Vector2i> cells = astar.CellPath(goal);
+    ASSERT_FALSE(cells.empty());
+    EXPECT_EQ(cells.front(), grid.CellOf(start));
+    EXPECT_EQ(cells.back(), goal);
+    for (size_t i = 1; i < cells.size(); ++i) {
+      EXPECT_LE((cells[i] - cells[i - 1]).cwiseAbs().maxCoeff(), 1);
+      EXPECT_TRUE(astar.Traversable(cells[i].x(), cells[i].y()));
+    }
+  }
+  // An unreachable goal (in the wall): no path.
+  NavigationMap astar(grid, params, start, NavigationMap::Search::kOnDemand);
+  EXPECT_FALSE(astar.SearchTo(grid.CellOf(Eigen::Vector2d(6.0, 4.0))));
+}
+
+TEST(NavigationMapTest, SearchCostDoesNotGrowWithTheMappedArea) {
+  // The same start and goal, 4 m apart, in corridors of 10 m and 40 m: the
+  // searches on demand settle the same cells, the whole search four times
+  // as many.
+  const ExplorerParams params;
+  const Eigen::Vector2d start(1.0, 1.0);
+  const Eigen::Vector2i goal_offset(80, 0);
+  std::vector<int> astar_cells;
+  std::vector<int> bounded_cells;
+  std::vector<int> full_cells;
+  for (const double length_m : {10.0, 40.0}) {
+    const OccupancyGrid grid = MappedCorridor(length_m);
+    NavigationMap astar(grid, params, start, NavigationMap::Search::kOnDemand);
+    ASSERT_TRUE(astar.SearchTo(grid.CellOf(start) + goal_offset));
+    astar_cells.push_back(astar.settled_cells());
+    NavigationMap bounded(grid, params, start, NavigationMap::Search::kOnDemand);
+    bounded.ExpandTo(6.0);
+    bounded_cells.push_back(bounded.settled_cells());
+    const NavigationMap full(grid, params, start);
+    full_cells.push_back(full.settled_cells());
+  }
+  EXPECT_EQ(astar_cells[0], astar_cells[1]);
+  EXPECT_EQ(bounded_cells[0], bounded_cells[1]);
+  EXPECT_GT(full_cells[1], 3 * full_cells[0]);
+  EXPECT_LT(astar_cells[1], full_cells[0]);
 }
 
 }  // namespace
