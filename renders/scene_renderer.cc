@@ -1,13 +1,16 @@
 #include "renders/scene_renderer.h"
 
 #include <GL/osmesa.h>
+#include <dlfcn.h>
 #include <mujoco/mujoco.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <mutex>
 #include <stdexcept>
+#include <string>
 
 #include "common/check.h"
 #include "sim/obstacles.h"
@@ -34,6 +37,52 @@ constexpr int kLegendWidth = 150;
 constexpr int kMinWidthForLegend = 400;
 constexpr float kWallGrey = 0.30f;
 constexpr float kFloorGrey = 0.88f;
+
+// OSMesa's entry points, loaded with dlopen on the first render rather than
+// linked: libOSMesa pulls in LLVM, whose relocations cost every process about
+// 0.1 s of CPU at start-up, rendering or not (docs/results.md, "Simulation
+// cost"). RTLD_GLOBAL makes its OpenGL symbols visible to MuJoCo's loader,
+// which looks them up in the process.
+struct OsMesaApi {
+  decltype(&OSMesaCreateContextExt) create_context_ext = nullptr;
+  decltype(&OSMesaMakeCurrent) make_current = nullptr;
+  decltype(&OSMesaGetCurrentContext) get_current_context = nullptr;
+  decltype(&OSMesaDestroyContext) destroy_context = nullptr;
+};
+
+constexpr const char* kOsMesaLibrary = "libOSMesa.so.8";
+
+// Loads the library once per process (never unloaded); std::runtime_error
+// naming the library and the missing symbol when it cannot.
+const OsMesaApi& LoadOsMesa() {
+  static OsMesaApi api;
+  static std::string problem;
+  static std::once_flag once;
+  std::call_once(once, [] {
+    void* library = dlopen(kOsMesaLibrary, RTLD_NOW | RTLD_GLOBAL);
+    if (library == nullptr) {
+      const char* why = dlerror();
+      problem = std::string("OSMesa: cannot load ") + kOsMesaLibrary + ": " + (why ? why : "?");
+      return;
+    }
+    auto find = [&](const char* name) {
+      void* symbol = dlsym(library, name);
+      if (symbol == nullptr && problem.empty()) {
+        problem = std::string("OSMesa: ") + kOsMesaLibrary + " has no " + name;
+      }
+      return symbol;
+    };
+    api.create_context_ext =
+        reinterpret_cast<decltype(api.create_context_ext)>(find("OSMesaCreateContextExt"));
+    api.make_current = reinterpret_cast<decltype(api.make_current)>(find("OSMesaMakeCurrent"));
+    api.get_current_context =
+        reinterpret_cast<decltype(api.get_current_context)>(find("OSMesaGetCurrentContext"));
+    api.destroy_context =
+        reinterpret_cast<decltype(api.destroy_context)>(find("OSMesaDestroyContext"));
+  });
+  if (!problem.empty()) throw std::runtime_error(problem);
+  return api;
+}
 
 // One line of the legend: a swatch and its name.
 struct LegendEntry {
@@ -85,8 +134,12 @@ struct SceneRenderer::Impl {
     if (gl != nullptr) {
       // Release the context before destroying it: Mesa keeps a current
       // context's state alive (a leak LeakSanitizer reports per process).
-      if (OSMesaGetCurrentContext() == gl) OSMesaMakeCurrent(nullptr, nullptr, GL_UNSIGNED_BYTE, 0, 0);
-      OSMesaDestroyContext(gl);
+      // (gl is set only once LoadOsMesa succeeded.)
+      const OsMesaApi& osmesa = LoadOsMesa();
+      if (osmesa.get_current_context() == gl) {
+        osmesa.make_current(nullptr, nullptr, GL_UNSIGNED_BYTE, 0, 0);
+      }
+      osmesa.destroy_context(gl);
     }
   }
 
@@ -289,10 +342,11 @@ void SceneRenderer::Impl::FrameView(const std::vector<sim::ObstacleFootprint>& o
 
 void SceneRenderer::Impl::StartOpenGl() {
   // OSMesa: a software OpenGL context drawing into memory.
-  gl = OSMesaCreateContextExt(OSMESA_RGBA, 24, 8, 8, nullptr);
+  const OsMesaApi& osmesa = LoadOsMesa();
+  gl = osmesa.create_context_ext(OSMESA_RGBA, 24, 8, 8, nullptr);
   if (gl == nullptr) throw std::runtime_error("OSMesa: cannot create an OpenGL context");
   gl_buffer.resize(static_cast<std::size_t>(width) * height * 4);
-  if (!OSMesaMakeCurrent(gl, gl_buffer.data(), GL_UNSIGNED_BYTE, width, height)) {
+  if (!osmesa.make_current(gl, gl_buffer.data(), GL_UNSIGNED_BYTE, width, height)) {
     throw std::runtime_error("OSMesa: cannot make the OpenGL context current");
   }
 
