@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 
 #include "common/angles.h"
 #include "common/grid2.h"
@@ -113,26 +115,58 @@ std::vector<Eigen::Vector2d> GlobalFrontierPoints(const OccupancyGrid& grid,
   return points;
 }
 
+// The rays march in steps of half a cell and neighbouring rays cross the
+// same cells, so a cell is visited several times: a ray's repeat of the cell
+// it just tested is skipped (same answer), and each unknown cell is counted
+// once through a stamp over the box of cells the rays can reach. Same count,
+// bit for bit, as testing every sample and sorting the cells
+// (tests/explorer/frontiers_test.cc checks it against that).
 double InformationGain(const OccupancyGrid& grid, const Eigen::Vector2d& p_W, double radius_m) {
   const double r = grid.resolution();
   const int num_rays = std::max(16, static_cast<int>(std::ceil(2.0 * kPi * radius_m / r)));
   const int steps = static_cast<int>(std::ceil(radius_m / (0.5 * r)));
-  // Count each unknown cell once.
-  std::vector<long long> counted;
+  // The rays' directions, as computed for each ray before (kept per thread
+  // for the last ray count, which is fixed by the params).
+  thread_local std::vector<Eigen::Vector2d> directions;
+  if (static_cast<int>(directions.size()) != num_rays) {
+    directions.resize(num_rays);
+    for (int k = 0; k < num_rays; ++k) {
+      const double th = 2.0 * kPi * k / num_rays;
+      directions[k] = Eigen::Vector2d(std::cos(th), std::sin(th));
+    }
+  }
+  // Every sample lies within radius_m of p_W, so within reach + 1 cells of
+  // its cell (floor's rounding); two cells of margin. A cell outside the box
+  // (never expected) is still counted once, through `outside`.
+  const int reach = static_cast<int>(std::ceil(radius_m / r)) + 2;
+  const Eigen::Vector2i center = grid.CellOf(p_W);
+  const int side = 2 * reach + 1;
+  thread_local std::vector<std::uint8_t> counted;
+  counted.assign(static_cast<std::size_t>(side) * side, 0);
+  std::vector<long long> outside;
+  long long unique = 0;
   for (int k = 0; k < num_rays; ++k) {
-    const double th = 2.0 * kPi * k / num_rays;
-    const Eigen::Vector2d u(std::cos(th), std::sin(th));
+    const Eigen::Vector2d& u = directions[k];
+    Eigen::Vector2i previous(std::numeric_limits<int>::min(), 0);
     for (int j = 1; j <= steps; ++j) {
       const Eigen::Vector2i c = grid.CellOf(p_W + (radius_m * j / steps) * u);
+      if (c == previous) continue;
+      previous = c;
       if (BlocksRay(grid, c.x(), c.y())) break;
-      if (grid.State(c.x(), c.y()) == CellState::kUnknown) {
-        counted.push_back((static_cast<long long>(c.y()) << 32) ^
-                          static_cast<unsigned int>(c.x()));
+      if (grid.State(c.x(), c.y()) != CellState::kUnknown) continue;
+      const int bx = c.x() - center.x() + reach;
+      const int by = c.y() - center.y() + reach;
+      if (bx >= 0 && bx < side && by >= 0 && by < side) {
+        std::uint8_t& stamp = counted[static_cast<std::size_t>(by) * side + bx];
+        unique += stamp == 0;
+        stamp = 1;
+      } else {
+        outside.push_back((static_cast<long long>(c.y()) << 32) ^ static_cast<unsigned int>(c.x()));
       }
     }
   }
-  std::sort(counted.begin(), counted.end());
-  const auto unique = std::unique(counted.begin(), counted.end()) - counted.begin();
+  std::sort(outside.begin(), outside.end());
+  unique += std::unique(outside.begin(), outside.end()) - outside.begin();
   return unique * r * r;
 }
 
