@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <vector>
 
 #include "common/check.h"
 #include "common/interrupt.h"
@@ -80,18 +81,29 @@ TrueCoverage::TrueCoverage(const std::vector<sim::ObstacleFootprint>& obstacles,
       [&](int i, int j) { return clearance(i, j) >= robot_radius_m; }, &standing);
 
   // Widened by the robot's radius to the free cells beside them.
+  // Asked per cell: is a standing cell within the robot's radius (a disk of
+  // cell offsets, listed once, the cell itself first)? Most free cells are
+  // standing cells themselves, so the disk is searched only near walls.
   const int reach = static_cast<int>(std::ceil(robot_radius_m / cell_m));
+  std::vector<Eigen::Vector2i> disk = {Eigen::Vector2i::Zero()};
+  for (int dj = -reach; dj <= reach; ++dj) {
+    for (int di = -reach; di <= reach; ++di) {
+      if ((di != 0 || dj != 0) && std::hypot(di, dj) * cell_m <= robot_radius_m + 1e-9) {
+        disk.emplace_back(di, dj);
+      }
+    }
+  }
   reachable_ = Grid2<std::uint8_t>(limits_, 0);
-  for (int j = 0; j < height; ++j) {
-    for (int i = 0; i < width; ++i) {
-      if (!standing(i, j)) continue;
-      for (int dj = -reach; dj <= reach; ++dj) {
-        for (int di = -reach; di <= reach; ++di) {
-          const int x = i + di;
-          const int y = j + dj;
-          if (!limits_.Contains(x, y)) continue;
-          if (std::hypot(di, dj) * cell_m > robot_radius_m + 1e-9) continue;
-          if (clearance(x, y) > kFreeMargin) reachable_(x, y) = 1;
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      if (!(clearance(x, y) > kFreeMargin)) continue;
+      for (const Eigen::Vector2i& offset : disk) {
+        // The disk is symmetric: a standing cell at (x, y) - offset.
+        const int i = x - offset.x();
+        const int j = y - offset.y();
+        if (limits_.Contains(i, j) && standing(i, j)) {
+          reachable_(x, y) = 1;
+          break;
         }
       }
     }
