@@ -295,6 +295,9 @@ rundir::RunSummary ClosedLoop::Summary(bool interrupted) const {
     filter.near_miss_failed_windows = check.near_miss_failed_windows;
     filter.near_miss_fraction = check.near_miss_fraction;
     filter.near_miss_since_s = check.near_miss_since_s;
+    filter.copies = check.copies;
+    filter.copied_scans = check.copied_scans;
+    filter.map_copied_at_s = check.map_copied_at_s;
     summary.filters.push_back(filter);
   }
   return summary;

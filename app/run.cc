@@ -182,15 +182,21 @@ std::vector<std::string> InnovationWarnings(const rundir::RunSummary& summary) {
   std::vector<std::string> lines;
   for (const rundir::RunSummary::Filter& f : summary.filters) {
     if (!f.innovation_inconsistent_since_s) continue;
-    char line[400];
+    char copied[160] = "";
+    if (f.map_copied_at_s) {
+      std::snprintf(copied, sizeof(copied),
+                    "; %d scans made new features of mapped structure, the first at t = %.1f s",
+                    f.copied_scans, *f.map_copied_at_s);
+    }
+    char line[560];
     std::snprintf(line, sizeof(line),
                   "warning: the %s filter is inconsistent with its own innovations from t = %.1f s "
                   "(%d of %d windows failed, mean NIS %.2f; %d of %d windows with too many near "
-                  "misses, %.1f %% of the observations; summary.json "
+                  "misses, %.1f %% of the observations%s; summary.json "
                   "filters.%s.innovation_check): its map and pose may be wrong",
                   f.name.c_str(), *f.innovation_inconsistent_since_s, f.innovation_failed_windows,
                   f.innovation_windows, f.innovation_mean_nis, f.near_miss_failed_windows,
-                  f.near_miss_windows, 100.0 * f.near_miss_fraction, f.name.c_str());
+                  f.near_miss_windows, 100.0 * f.near_miss_fraction, copied, f.name.c_str());
     lines.emplace_back(line);
   }
   return lines;

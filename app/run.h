@@ -56,7 +56,8 @@ RunResult RunSimulation(const RunConfig& config, const RunOptions& options);
 
 /// One warning line per filter of `summary` whose innovation check found it
 /// inconsistent: the filter, the time it lost consistency with its own
-/// innovations, and the key to look at.
+/// innovations, the scans that copied mapped structure (if any), and the key
+/// to look at.
 std::vector<std::string> InnovationWarnings(const rundir::RunSummary& summary);
 
 /// The line `mjslam run` prints when the filters assume another range noise

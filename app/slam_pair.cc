@@ -80,7 +80,8 @@ void SlamPair::Step(const SensorRecord& record) {
       if (record.has_scan) ++f.scans_processed;
       f.innovation_check.Add(record.t_s, f.report.nis_sum, f.report.num_matched,
                              f.report.num_observed,
-                             f.innovation_check.NearMisses(f.report.nearest_nis));
+                             f.innovation_check.NearMisses(f.report.nearest_nis),
+                             f.innovation_check.Copies(f.report.association, f.report.nearest_nis));
     } else {
       // Busy: the scan is lost; with command input the record's command
       // waits for the next prediction.

@@ -46,7 +46,10 @@ nlohmann::json ToJson(const RunSummary& summary) {
           {"near_miss_fraction", std::isfinite(f.near_miss_fraction)
                                      ? nlohmann::json(f.near_miss_fraction)
                                      : nlohmann::json(nullptr)},
-          {"near_miss_since_s", time_or_null(f.near_miss_since_s)}}}};
+          {"near_miss_since_s", time_or_null(f.near_miss_since_s)},
+          {"copies", f.copies},
+          {"copied_scans", f.copied_scans},
+          {"map_copied_at_s", time_or_null(f.map_copied_at_s)}}}};
   }
   return json;
 }

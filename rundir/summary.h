@@ -63,6 +63,12 @@ struct RunSummary {
     int near_miss_failed_windows = 0;
     double near_miss_fraction = 0.0;
     std::optional<double> near_miss_since_s;
+    /// Its copy test: new features within the near-miss NIS of a mapped
+    /// feature over the run, scans with too many, and the time of the first
+    /// such scan (none: never).
+    long copies = 0;
+    int copied_scans = 0;
+    std::optional<double> map_copied_at_s;
   };
   std::vector<Filter> filters;
 };

@@ -32,6 +32,8 @@ std::vector<ParamProblem> InnovationCheckParams::Validate() const {
   check.Require(sustained_windows >= 1, "sustained_windows", sustained_windows, "a value >= 1");
   check.Require(near_miss_max_nis >= 0.0 && std::isfinite(near_miss_max_nis), "near_miss_max_nis",
                 near_miss_max_nis, "a finite value >= 0 (0: off)");
+  check.Require(copies_per_scan >= 0, "copies_per_scan", copies_per_scan,
+                "a value >= 0 (0: off)");
   return check.problems();
 }
 
@@ -70,8 +72,21 @@ int InnovationCheck::NearMisses(const std::vector<double>& nearest_nis) const {
   return misses;
 }
 
+int InnovationCheck::Copies(const Association& association,
+                            const std::vector<double>& nearest_nis) const {
+  MJSLAM_CHECK(association.outcome.size() == nearest_nis.size());
+  int copies = 0;
+  for (std::size_t o = 0; o < nearest_nis.size(); ++o) {
+    copies += association.outcome[o] == AssociationOutcome::kNew &&
+                      nearest_nis[o] < params_.near_miss_max_nis
+                  ? 1
+                  : 0;
+  }
+  return copies;
+}
+
 void InnovationCheck::Add(double t_s, double nis_sum, int count, int num_observed,
-                          int num_near_misses) {
+                          int num_near_misses, int num_copies) {
   if (!window_open_) {
     window_open_ = true;
     window_start_s_ = t_s;
@@ -85,6 +100,13 @@ void InnovationCheck::Add(double t_s, double nis_sum, int count, int num_observe
   window_observed_ += num_observed;
   window_near_misses_ += num_near_misses;
   if (num_observed > 0) ++window_scans_;
+  result_.copies += num_copies;
+  if (params_.near_miss_max_nis > 0.0 && params_.copies_per_scan > 0 &&
+      num_copies >= params_.copies_per_scan) {
+    ++result_.copied_scans;
+    if (!result_.map_copied_at_s) result_.map_copied_at_s = t_s;
+    ReportInconsistent(t_s);
+  }
   total_sum_ += nis_sum;
   result_.observations += count;
   if (result_.observations > 0) result_.mean_nis = total_sum_ / result_.observations;
@@ -133,6 +155,12 @@ void InnovationCheck::JudgeNearMisses() {
   }
 }
 
+void InnovationCheck::ReportInconsistent(double since_s) {
+  if (!result_.inconsistent_since_s || since_s < *result_.inconsistent_since_s) {
+    result_.inconsistent_since_s = since_s;
+  }
+}
+
 bool InnovationCheck::Streak(bool failed, int* streak, double* streak_start_s) {
   if (!failed) {
     *streak = 0;
@@ -141,10 +169,7 @@ bool InnovationCheck::Streak(bool failed, int* streak, double* streak_start_s) {
   if (*streak == 0) *streak_start_s = window_start_s_;
   ++*streak;
   if (*streak < params_.sustained_windows) return false;
-  // The earliest start of a sustained streak of either test.
-  if (!result_.inconsistent_since_s || *streak_start_s < *result_.inconsistent_since_s) {
-    result_.inconsistent_since_s = *streak_start_s;
-  }
+  ReportInconsistent(*streak_start_s);
   return true;
 }
 

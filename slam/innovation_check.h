@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "common/params.h"
+#include "slam/data_association.h"
 
 namespace mjslam::slam {
 
@@ -24,6 +25,11 @@ struct InnovationCheckParams {
   /// one (>= 0; 0 turns the near-miss test off). A filter whose pose or map is
   /// a few sigma off sees the walls it mapped just outside the gate.
   double near_miss_max_nis = 100.0;
+  /// Copies: an observation that became a new feature although a map
+  /// feature of its kind lies within NIS `near_miss_max_nis` is a copy of
+  /// mapped structure. A scan with at least this many copies reports the
+  /// map copied (>= 0; 0 turns the copy test off).
+  int copies_per_scan = 3;
 
   template <typename Archive>
   void Serialize(Archive* a) {
@@ -31,6 +37,7 @@ struct InnovationCheckParams {
     a->Visit(MJSLAM_NVP(probability));
     a->Visit(MJSLAM_NVP(sustained_windows));
     a->Visit(MJSLAM_NVP(near_miss_max_nis));
+    a->Visit(MJSLAM_NVP(copies_per_scan));
   }
   /// Every out-of-range field, keys relative to this struct.
   std::vector<ParamProblem> Validate() const;
@@ -58,8 +65,17 @@ struct InnovationCheckResult {
   /// Start time of the first streak of `sustained_windows` windows failing
   /// the near-miss test (none: never).
   std::optional<double> near_miss_since_s;
-  /// Start time of the first streak of `sustained_windows` failing windows
-  /// of either test, the earlier (none: the filter stayed consistent with
+  /// Copies over the run (new features within NIS `near_miss_max_nis` of a
+  /// mapped feature of their kind), and the scans with at least
+  /// `copies_per_scan` of them.
+  long copies = 0;
+  int copied_scans = 0;
+  /// Time of the first scan with at least `copies_per_scan` copies (none:
+  /// never): the filter added a copy of what it had mapped, the signature
+  /// of a lost pose.
+  std::optional<double> map_copied_at_s;
+  /// The earliest of: the start of the first streak of `sustained_windows`
+  /// failing windows of the NIS or near-miss test, and map_copied_at_s, the earlier (none: the filter stayed consistent with
   /// its innovations).
   std::optional<double> inconsistent_since_s;
   /// Whether such a streak happened.
@@ -89,6 +105,17 @@ struct InnovationCheckResult {
 /// feature. A window fails when its fraction of near misses among its
 /// observations exceeds p0 + z_p sqrt(p0 (1 - p0) / K), with K its scans
 /// with observations (the observations of a scan share its pose error).
+///
+/// Neither test sees the loss when every observation of a scan misses the
+/// gate at once and becomes a new feature (the paper's rule of new
+/// features; EkfParams::new_features_need_match false): that scan's
+/// observations are not near misses, and the next scans match the copies it
+/// made. The third, copy test counts the new features that lie within
+/// `near_miss_max_nis` of a mapped feature of their kind (at or above the
+/// new-feature threshold): a scan with `copies_per_scan` of them reports the
+/// map copied at once. Its threshold is set from measured runs, not from a
+/// law: healthy runs add at most one copy per scan (docs/results.md, "The
+/// maze map loss").
 class InnovationCheck {
  public:
   /// `gate`: the association gate on NIS (> 0), e.g. ChiSquare2Quantile(0.99).
@@ -100,12 +127,20 @@ class InnovationCheck {
   void Add(double t_s, double nis_sum, int count) { Add(t_s, nis_sum, count, count, 0); }
   /// Adds one step with its `num_observed` observations, of which
   /// `num_near_misses` were near misses (NearMisses).
-  void Add(double t_s, double nis_sum, int count, int num_observed, int num_near_misses);
+  void Add(double t_s, double nis_sum, int count, int num_observed, int num_near_misses) {
+    Add(t_s, nis_sum, count, num_observed, num_near_misses, 0);
+  }
+  /// Adds one step with its near misses and its `num_copies` copies (Copies).
+  void Add(double t_s, double nis_sum, int count, int num_observed, int num_near_misses,
+           int num_copies);
 
   /// The near misses among a scan's observations given each one's nearest
   /// NIS to a map feature of its kind (slam::StepReport::nearest_nis):
   /// those in [gate, near_miss_max_nis).
   int NearMisses(const std::vector<double>& nearest_nis) const;
+  /// The copies among a scan's observations: those that became new features
+  /// (AssociationOutcome::kNew) with `nearest_nis` below near_miss_max_nis.
+  int Copies(const Association& association, const std::vector<double>& nearest_nis) const;
 
   /// The result so far (the open window left out).
   InnovationCheckResult result() const { return result_; }
@@ -119,6 +154,8 @@ class InnovationCheck {
   // The two tests of a closed window.
   void JudgeNis();
   void JudgeNearMisses();
+  // Sets inconsistent_since_s to `since_s` unless it is set earlier.
+  void ReportInconsistent(double since_s);
   // Updates a streak of failing windows with this window's verdict; when the
   // streak is sustained, sets inconsistent_since_s (the earliest) and
   // returns true.

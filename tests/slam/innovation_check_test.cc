@@ -1,7 +1,8 @@
 // The innovation consistency check (slam/innovation_check.h) on drawn NIS
 // values: its truncated chi-square moments, quiet on consistent innovations,
 // firing on innovations twice their stated variance; its near-miss test quiet
-// on a consistent filter and firing after a pose jump.
+// on a consistent filter and firing after a pose jump; its copy test
+// counting new features near mapped ones and firing on a window of them.
 #include "slam/innovation_check.h"
 
 #include <cmath>
@@ -150,13 +151,56 @@ TEST(InnovationCheckTest, NearMissTestFiresAfterAPoseJump) {
   EXPECT_FALSE(check.result().inconsistent());
 }
 
+TEST(InnovationCheckTest, CountsNewFeaturesNearMappedOnesAsCopies) {
+  const InnovationCheck check(InnovationCheckParams{}, ChiSquare2Quantile(0.99));
+  Association association;
+  association.outcome = {AssociationOutcome::kNew, AssociationOutcome::kNew,
+                         AssociationOutcome::kNew, AssociationOutcome::kMatched,
+                         AssociationOutcome::kAmbiguous, AssociationOutcome::kUnanchored};
+  association.feature = {-1, -1, -1, 0, -1, -1};
+  // New near a mapped feature (a copy), new far from it, new with no
+  // feature of its kind, matched, ambiguous, held back: one copy.
+  const double inf = std::numeric_limits<double>::infinity();
+  EXPECT_EQ(check.Copies(association, {30.0, 100.0, inf, 1.0, 12.0, 40.0}), 1);
+}
+
+TEST(InnovationCheckTest, CopyTestFiresOnAScanOfCopiesOnly) {
+  // A healthy run adds a copy now and then (at most one per scan in the
+  // measured runs: quiet even when they come every scan); a scan that
+  // becomes new features at a wrong pose adds copies_per_scan at once and
+  // is reported at its time.
+  const InnovationCheckParams params;
+  InnovationCheck check(params, ChiSquare2Quantile(0.99));
+  for (int step = 0; step < 1000; ++step) {
+    const int copies = step == 620 ? params.copies_per_scan : step % 2 == 0 ? 1 : 0;
+    check.Add(step * 0.1, 8.0, 5, 6, 0, copies);
+  }
+  const InnovationCheckResult result = check.result();
+  EXPECT_EQ(result.copied_scans, 1);
+  ASSERT_TRUE(result.map_copied_at_s.has_value());
+  EXPECT_NEAR(*result.map_copied_at_s, 62.0, 1e-9);
+  ASSERT_TRUE(result.inconsistent());
+  EXPECT_NEAR(*result.inconsistent_since_s, 62.0, 1e-9);
+  EXPECT_EQ(result.copies, 499 + params.copies_per_scan);
+  EXPECT_EQ(result.near_miss_failed_windows, 0);
+  // Off (copies_per_scan = 0): counted, never judged.
+  InnovationCheckParams off;
+  off.copies_per_scan = 0;
+  InnovationCheck quiet(off, ChiSquare2Quantile(0.99));
+  for (int step = 0; step < 300; ++step) quiet.Add(step * 0.1, 8.0, 5, 6, 0, 10);
+  EXPECT_EQ(quiet.result().copies, 3000);
+  EXPECT_EQ(quiet.result().copied_scans, 0);
+  EXPECT_FALSE(quiet.result().inconsistent());
+}
+
 TEST(InnovationCheckTest, RejectsBadSettings) {
   InnovationCheckParams params;
   params.window_s = 0.0;
   params.probability = 1.0;
   params.sustained_windows = 0;
   params.near_miss_max_nis = -1.0;
-  EXPECT_EQ(params.Validate().size(), 4u);
+  params.copies_per_scan = -1;
+  EXPECT_EQ(params.Validate().size(), 5u);
 }
 
 }  // namespace

@@ -15,6 +15,8 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Cholesky>
+
 #include "app/evaluate.h"
 #include "app/run_config.h"
 #include "common/angles.h"
@@ -40,6 +42,10 @@ struct AssociationAudit {
   std::map<int, double> matched_nis;
   /// One line per wrong match or duplicate between the times asked for.
   std::vector<std::string> events;
+  /// One line per scan with a copy or a near miss between the times asked
+  /// for: "scan t observed matched new unanchored copies near_misses
+  /// position_error_m pose_nees".
+  std::vector<std::string> scan_lines;
   /// Largest position error of the replayed filter (metres), per 50 s.
   std::map<int, double> max_error_m;
   /// Largest |x - recorded x| of the replayed filter (0: bit-identical).
@@ -221,7 +227,8 @@ inline AssociationAudit AuditAssociations(const std::string& dir, const std::str
     const int features_before = filter.num_features();
     const slam::StepReport report = filter.Step(record, record.has_scan ? &features : nullptr);
     check.Add(record.t_s, report.nis_sum, report.num_matched, report.num_observed,
-              check.NearMisses(report.nearest_nis));
+              check.NearMisses(report.nearest_nis),
+              check.Copies(report.association, report.nearest_nis));
     audit.innovation = check.result();
     audit.max_replay_difference = std::max(
         audit.max_replay_difference, std::abs(filter.X_WR().x - trajectory.rows[i][recorded_x]));
@@ -232,6 +239,29 @@ inline AssociationAudit AuditAssociations(const std::string& dir, const std::str
     const bool shown = step.t_s >= t_from && (t_to < 0.0 || step.t_s <= t_to);
     const int bin = static_cast<int>(step.t_s / 50.0);
     audit.max_error_m[bin] = std::max(audit.max_error_m[bin], error);
+    {
+      int copies = 0;
+      int near = 0;
+      for (int o = 0; o < report.num_observed; ++o) {
+        const double nis = report.nearest_nis[o];
+        const bool close = nis < config.slam.innovation_check.near_miss_max_nis;
+        const slam::AssociationOutcome outcome = report.association.outcome[o];
+        if (outcome == slam::AssociationOutcome::kNew && close) ++copies;
+        if (outcome != slam::AssociationOutcome::kMatched && close &&
+            nis >= slam::ChiSquare2Quantile(config.slam.ekf.gate_probability)) {
+          ++near;
+        }
+      }
+      if (shown && (copies > 0 || near > 0)) {
+        const Eigen::Vector3d e(X_WR.x - step.X_WR_true.x, X_WR.y - step.X_WR_true.y,
+                                WrapAngle(X_WR.theta - step.X_WR_true.theta));
+        const double nees = e.dot(filter.pose_covariance().ldlt().solve(e));
+        std::snprintf(line, sizeof(line), "scan %.1f %d %d %d %d %d %d %.4f %.1f", step.t_s,
+                      report.num_observed, report.num_matched, report.num_new,
+                      report.num_unanchored, copies, near, error, nees);
+        audit.scan_lines.emplace_back(line);
+      }
+    }
     int added = 0;
     for (int o = 0; o < report.num_observed; ++o) {
       const slam::AssociationOutcome outcome = report.association.outcome[o];

@@ -31,6 +31,7 @@ int main(int argc, char** argv) {
     mjslam::testing::AssociationAudit audit =
         mjslam::testing::AuditAssociations(argv[1], name, overrides, t_from, t_to);
     for (const std::string& event : audit.events) std::printf("%s\n", event.c_str());
+    for (const std::string& scan : audit.scan_lines) std::printf("%s\n", scan.c_str());
     std::printf("replay: largest |x - recorded %s_x| %.3g m\n", name.c_str(),
                 audit.max_replay_difference);
     std::printf("per 50 s: wrong line matches, new line features for lines already mapped; all "
@@ -47,13 +48,15 @@ int main(int argc, char** argv) {
     const mjslam::slam::InnovationCheckResult& check = audit.innovation;
     std::printf("innovation check: %s since %.1f s; NIS test %d of %d windows failed (mean NIS "
                 "%.2f); near-miss test %d of %d windows failed (since %.1f s), %.2f %% of the "
-                "observations near misses\n",
+                "observations near misses; copy test %d scans failed (first at %.1f s), %ld "
+                "copies\n",
                 check.inconsistent() ? "INCONSISTENT" : "consistent",
                 check.inconsistent() ? *check.inconsistent_since_s : -1.0, check.failed_windows,
                 check.windows, check.mean_nis, check.near_miss_failed_windows,
                 check.near_miss_windows,
                 check.near_miss_since_s ? *check.near_miss_since_s : -1.0,
-                100.0 * check.near_miss_fraction);
+                100.0 * check.near_miss_fraction, check.copied_scans,
+                check.map_copied_at_s ? *check.map_copied_at_s : -1.0, check.copies);
   } catch (const std::exception& error) {
     std::fprintf(stderr, "association_trace: %s\n", error.what());
     return 1;
