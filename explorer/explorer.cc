@@ -7,6 +7,7 @@
 
 #include "common/angles.h"
 #include "common/check.h"
+#include "common/grid2.h"
 #include "explorer/frontiers.h"
 #include "explorer/point_h_controller.h"
 
@@ -52,6 +53,26 @@ constexpr double kRecoverySpeedMps = 0.1;
 constexpr double kRecoveryTurnRadps = 0.4;
 // The first cost bound of the search for a goal, metres (then doubled).
 constexpr double kFirstSearchCostM = 4.0;
+// A robot that backs out of a narrow place stops after this distance even
+// without turning room, metres.
+constexpr double kMaxBackOutM = 1.0;
+// A path that starts with a turn in place of more than this reverses the
+// robot's direction, degrees.
+constexpr double kReverseDeg = 90.0;
+
+// Whether no occupied cell lies on the segment from `from_W` to `to_W` (the
+// cell of `to_W` excluded): a viewpoint must see its frontier point.
+bool SeesPoint(const OccupancyGrid& grid, const Eigen::Vector2d& from_W,
+               const Eigen::Vector2d& to_W) {
+  const Eigen::Vector2i last = grid.CellOf(to_W);
+  bool clear = true;
+  TraverseSegment(grid.limits(), from_W, to_W, [&](int ix, int iy) {
+    if (Eigen::Vector2i(ix, iy) != last && grid.State(ix, iy) == CellState::kOccupied) {
+      clear = false;
+    }
+  });
+  return clear;
+}
 
 }  // namespace
 
@@ -103,6 +124,7 @@ void Explorer::DropGoal(bool blacklist, bool failed) {
     blacklist_failed_.push_back(failed ? 1 : 0);
   }
   has_goal_ = false;
+  backing_out_ = false;
   tracker_.Clear();
   ++log_version_;
 }
@@ -144,9 +166,33 @@ bool Explorer::PlanToGoal(const NavigationMap& map, const Pose2& X_WR, double t_
   Path path = PathOfPointH(PlanPath(map, params_, goal_W_, X_WR.theta), a_m_, X_WR.theta);
   last_plan_t_s_ = t_s;
   if (path.empty()) return false;
+  // A path that reverses the robot's direction from a place where it cannot
+  // turn (a door, a narrow strip): back out straight first, the way it came.
+  const double turn = std::abs(WrapAngle(path.front().heading_rad - X_WR.theta));
+  backing_out_ = path.front().turn_in_place && turn > DegToRad(kReverseDeg) &&
+                 map.ClearanceAt(AxleOf(X_WR)) < params_.turn_clearance_m;
+  if (backing_out_) back_out_from_W_ = AxleOf(X_WR);
   tracker_.SetPath(std::move(path));
   ++log_version_;
   return true;
+}
+
+Twist2 Explorer::BackOut(const Pose2& X_WR, double t_s, double dt_s) {
+  clearance_.Update(grid_);
+  const Eigen::Vector2d axle = AxleOf(X_WR);
+  const Eigen::Vector2i cell = grid_.CellOf(axle);
+  const bool room = grid_.Contains(cell.x(), cell.y()) &&
+                    clearance_.Clearance(cell.x(), cell.y()) >= params_.turn_clearance_m;
+  if (room || (axle - back_out_from_W_).norm() >= kMaxBackOutM || blocked_s_ > 0.0) {
+    backing_out_ = false;
+    // Backing out to turning room is a manoeuvre, not a lack of progress.
+    if (room) progress_t_s_ = t_s;
+    Replan(X_WR, t_s);
+    return tracker_.last_command();
+  }
+  const Twist2 target{-params_.narrow_speed_mps, 0.0};
+  return RateLimit(tracker_.last_command(), target, params_.max_linear_accel_mps2 * dt_s,
+                   params_.max_angular_accel_radps2 * dt_s);
 }
 
 std::vector<Explorer::Candidate> Explorer::ScoreFrontiers(
@@ -212,11 +258,14 @@ double Explorer::BestViewpoint(const NavigationMap& map, const Eigen::Vector2d& 
   for (int iy = c.y() - window; iy <= c.y() + window; ++iy) {
     for (int ix = c.x() - window; ix <= c.x() + window; ++ix) {
       const double cost = map.CostTo(ix, iy);
-      if (!std::isfinite(cost) || !map.Comfortable(ix, iy)) continue;
+      if (!std::isfinite(cost) || !map.Comfortable(ix, iy) ||
+          map.Clearance(ix, iy) < params_.turn_clearance_m) {
+        continue;
+      }
       const Eigen::Vector2d cell = grid_.CellCenter(ix, iy);
       const double distance = (cell - p_W).norm();
       if (distance > params_.view_distance_m) continue;
-      if (cost + 2.0 * distance < best) {
+      if (cost + 2.0 * distance < best && SeesPoint(grid_, cell, p_W)) {
         best = cost + 2.0 * distance;
         *viewpoint_W = cell;
       }
@@ -331,10 +380,12 @@ void Explorer::Replan(const Pose2& X_WR, double t_s) {
   // A* to the goal only: the search's cost follows the path, not the map.
   NavigationMap map(grid_, clearance_, params_, AxleOf(X_WR), NavigationMap::Search::kOnDemand);
   map.SearchTo(grid_.CellOf(goal_W_));
-  const double remaining_before = best_remaining_m_;
+  const double remaining_before = RemainingPath(X_WR);
   if (PlanToGoal(map, X_WR, t_s)) {
-    // Keep the progress clock: a new plan is not progress.
-    best_remaining_m_ = std::min(remaining_before, RemainingPath(X_WR));
+    // Keep the progress clock and move the reference by the change of
+    // length the new plan makes: a new plan is neither progress nor a loss
+    // of it, so progress is the distance driven along the path.
+    best_remaining_m_ += RemainingPath(X_WR) - remaining_before;
   } else {
     DropGoal(true);
     ChooseGoal(X_WR, t_s);
@@ -412,14 +463,16 @@ ExplorerOutput Explorer::Step(const Pose2& X_WR, const LaserScan* scan, const Po
   // the goal (kept, replaced or replanned first).
   Twist2 command;
   if (phase_ == Phase::kInitialTurn) command = InitialTurn(X_WR, dt_s);
-  if (phase_ == Phase::kExploring) {
+  if (phase_ == Phase::kExploring && backing_out_) command = BackOut(X_WR, t_s, dt_s);
+  if (phase_ == Phase::kExploring && !backing_out_) {
     CheckGoal(X_WR, scan != nullptr, t_s);
     if (!has_goal_) {
       ChooseGoal(X_WR, t_s);
     } else if (ScanBlocksPath() || t_s - last_plan_t_s_ >= params_.replan_period_s) {
       Replan(X_WR, t_s);
     }
-    if (!finished_) command = tracker_.Command(X_WR, dt_s);
+    if (!finished_ && !backing_out_) command = tracker_.Command(X_WR, dt_s);
+    if (!finished_ && backing_out_) command = BackOut(X_WR, t_s, dt_s);
   }
 
   if (finished_) {

@@ -150,8 +150,14 @@ class Explorer {
   // `viewpoint_W` (untouched when there is none: the cost is infinite).
   double BestViewpoint(const NavigationMap& map, const Eigen::Vector2d& p_W,
                        Eigen::Vector2d* viewpoint_W) const;
-  // Plans a path to the current goal; false when there is none.
+  // Plans a path to the current goal; false when there is none. Starts a
+  // back-out when the path reverses the robot's direction (a turn in place
+  // of more than 90 deg first) where the axle lacks turn_clearance_m.
   bool PlanToGoal(const NavigationMap& map, const Pose2& X_WR, double t_s);
+  // One step of backing out straight (at narrow_speed_mps) until the axle
+  // has turn_clearance_m, has backed 1 m, or the safety layer holds it; then
+  // replans and returns the last command.
+  Twist2 BackOut(const Pose2& X_WR, double t_s, double dt_s);
   // Drops the current goal; blacklists it when `blacklist`, as failed when
   // `failed` (otherwise as reached).
   void DropGoal(bool blacklist, bool failed = true);
@@ -195,6 +201,11 @@ class Explorer {
   double recovery_until_s_ = -1.0;
   // Index of the escape motion of the current recovery, or -1.
   int recovery_escape_ = -1;
+
+  // Backing out of a narrow place before a path that reverses direction,
+  // and where the axle was when it began.
+  bool backing_out_ = false;
+  Eigen::Vector2d back_out_from_W_ = Eigen::Vector2d::Zero();
 
   double turned_rad_ = 0.0;
   double last_theta_ = 0.0;

@@ -106,6 +106,14 @@ void NavigationMap::Start(Search search) {
   if (search == Search::kFull) ExpandTo(kInfinity);
 }
 
+double NavigationMap::StepCostFactor(double clearance_m) const {
+  const double shortfall =
+      std::max(0.0, params_.preferred_clearance_m - clearance_m) / params_.preferred_clearance_m;
+  const double narrow =
+      std::max(0.0, params_.clearance_m + kNarrowMarginM - clearance_m) / kNarrowMarginM;
+  return 1.0 + params_.clearance_cost_weight * shortfall + params_.narrow_cost_weight * narrow;
+}
+
 bool NavigationMap::SettleNext(int goal) {
   static constexpr int dx[8] = {1, -1, 0, 0, 1, 1, -1, -1};
   static constexpr int dy[8] = {0, 0, 1, -1, 1, -1, 1, -1};
@@ -140,11 +148,7 @@ bool NavigationMap::SettleNext(int goal) {
       // Diagonal moves must not cut the corner of a blocked cell.
       if (k >= 4 && (!Traversable(ix + dx[k], iy) || !Traversable(ix, iy + dy[k]))) continue;
       const int j = grid_.Index(jx, jy);
-      const double shortfall =
-          std::max(0.0, params_.preferred_clearance_m - (*clearance_)[j]) /
-          params_.preferred_clearance_m;
-      const double step = (k < 4 ? r : r * std::sqrt(2.0)) *
-                          (1.0 + params_.clearance_cost_weight * shortfall);
+      const double step = (k < 4 ? r : r * std::sqrt(2.0)) * StepCostFactor((*clearance_)[j]);
       // Compared as stored (float): a double compared with its own rounding
       // would re-push a cell at an equal cost, without end.
       const float next = static_cast<float>(cost + step);
