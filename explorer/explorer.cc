@@ -153,19 +153,19 @@ Eigen::Vector2d Explorer::AxleOf(const Pose2& X_WR) const {
   return X_WR * Eigen::Vector2d(-a_m_, 0.0);
 }
 
-double Explorer::RemainingPath(const Pose2& X_WR) const {
-  const Path& path = tracker_.path();
-  if (path.empty()) return 0.0;
-  const PathPoint& near = path[tracker_.index()];
-  return path.back().s_m - near.s_m + (near.p_W - X_WR.translation()).norm();
-}
-
 bool Explorer::PlanToGoal(const NavigationMap& map, const Pose2& X_WR, double t_s) {
   // The plan is the axle's (its clearance covers the body in every
   // heading); the tracker follows the path of h that goes with it.
-  Path path = PathOfPointH(PlanPath(map, params_, goal_W_, X_WR.theta), a_m_, X_WR.theta);
+  const Path axle_path = PlanPath(map, params_, goal_W_, X_WR.theta);
   last_plan_t_s_ = t_s;
-  if (path.empty()) return false;
+  if (axle_path.empty()) return false;
+  // Progress: the axle's path to the goal, planned from where the axle is,
+  // got shorter (turning in place or swinging h is none).
+  if (axle_path.back().s_m < best_remaining_m_ - params_.progress_min_m) {
+    best_remaining_m_ = axle_path.back().s_m;
+    progress_t_s_ = t_s;
+  }
+  Path path = PathOfPointH(axle_path, a_m_, X_WR.theta);
   // A path that reverses the robot's direction from a place where it cannot
   // turn (a door, a narrow strip): back out straight first, the way it came.
   const double turn = std::abs(WrapAngle(path.front().heading_rad - X_WR.theta));
@@ -295,9 +295,8 @@ void Explorer::ChooseGoal(const Pose2& X_WR, double t_s) {
     frontier_W_ = candidate.frontier_W;
     goal_W_ = candidate.goal_W;
     has_goal_ = true;
+    best_remaining_m_ = std::numeric_limits<double>::infinity();
     if (PlanToGoal(map, X_WR, t_s)) {
-      best_remaining_m_ = RemainingPath(X_WR);
-      progress_t_s_ = t_s;
       blocked_total_s_ = 0.0;
       return;
     }
@@ -348,11 +347,6 @@ void Explorer::CheckGoal(const Pose2& X_WR, bool new_scan, double t_s) {
     DropGoal(false);
   }
   if (has_goal_) {
-    const double remaining = RemainingPath(X_WR);
-    if (remaining < best_remaining_m_ - params_.progress_min_m) {
-      best_remaining_m_ = remaining;
-      progress_t_s_ = t_s;
-    }
     if (t_s - progress_t_s_ > params_.progress_timeout_s ||
         blocked_total_s_ > params_.blocked_timeout_s) {
       DropGoal(true);
@@ -380,13 +374,7 @@ void Explorer::Replan(const Pose2& X_WR, double t_s) {
   // A* to the goal only: the search's cost follows the path, not the map.
   NavigationMap map(grid_, clearance_, params_, AxleOf(X_WR), NavigationMap::Search::kOnDemand);
   map.SearchTo(grid_.CellOf(goal_W_));
-  const double remaining_before = RemainingPath(X_WR);
-  if (PlanToGoal(map, X_WR, t_s)) {
-    // Keep the progress clock and move the reference by the change of
-    // length the new plan makes: a new plan is neither progress nor a loss
-    // of it, so progress is the distance driven along the path.
-    best_remaining_m_ += RemainingPath(X_WR) - remaining_before;
-  } else {
+  if (!PlanToGoal(map, X_WR, t_s)) {
     DropGoal(true);
     ChooseGoal(X_WR, t_s);
   }
@@ -441,7 +429,12 @@ ExplorerOutput Explorer::SafeOutput(const Twist2& wanted, const Pose2& X_WR, dou
   bool limited = false;
   command = SafetyFilter(command, X_WR, obstacles, params_, a_m_, dt_s, &limited);
   tracker_.set_last_command(command);
-  if (limited && std::abs(command.v_mps) < 1e-3 && std::abs(command.w_radps) < 1e-3) {
+  // Held still, or held from driving on (only a turn in place left where
+  // the robot wanted to drive: at a door's jamb, a turn that never ends).
+  const bool held_from_driving = std::abs(wanted.v_mps) >= 1e-3 &&
+                                 std::abs(command.v_mps) < 1e-3;
+  if (limited && (held_from_driving ||
+                  (std::abs(command.v_mps) < 1e-3 && std::abs(command.w_radps) < 1e-3))) {
     blocked_s_ += dt_s;
     blocked_total_s_ += dt_s;
   } else {

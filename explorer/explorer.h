@@ -117,7 +117,7 @@ class Explorer {
   Twist2 InitialTurn(const Pose2& X_WR, double dt_s);
   // Drops the goal when it is reached, explored meanwhile (`new_scan` only),
   // or failed (no progress within progress_timeout_s, blocked for
-  // blocked_timeout_s); tracks the progress along the path.
+  // blocked_timeout_s; progress is measured at each plan, see PlanToGoal).
   void CheckGoal(const Pose2& X_WR, bool new_scan, double t_s);
   // Whether an echo of the last scan lies on the path ahead (between
   // kPathCheckSkipM and kPathCheckRangeM along it) within the body's half
@@ -168,8 +168,6 @@ class Explorer {
   std::vector<Eigen::Vector2d> NearbyObstacles(const Pose2& X_WR) const;
   // The centre of the axle, a_m behind h: the point the planner plans for.
   Eigen::Vector2d AxleOf(const Pose2& X_WR) const;
-  // Remaining length of the path from h, metres.
-  double RemainingPath(const Pose2& X_WR) const;
 
   ExplorerParams params_;
   double a_m_;
@@ -191,6 +189,8 @@ class Explorer {
   Eigen::Vector2d frontier_W_ = Eigen::Vector2d::Zero();
   Eigen::Vector2d goal_W_ = Eigen::Vector2d::Zero();
   double last_plan_t_s_ = 0.0;
+  // The shortest axle path to the goal planned so far (each plan starts at
+  // the axle), and when it last got progress_min_m shorter.
   double best_remaining_m_ = 0.0;
   double progress_t_s_ = 0.0;
   // Time the safety layer has held the robot still: in a row (triggers a

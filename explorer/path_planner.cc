@@ -420,9 +420,12 @@ Path PlanPath(const NavigationMap& map, const ExplorerParams& params,
   // Turn toward the first leg first when it leaves far off the heading.
   if (path.size() >= 2) {
     const double error = WrapAngle(path.front().heading_rad - heading_rad);
-    const double limit_deg = LegIsNarrow(map, params, vertices[0], vertices[1])
-                                 ? std::min(kAlignBeforeNarrowDeg, params.turn_in_place_deg)
-                                 : params.turn_in_place_deg;
+    // Where the axle has room to turn: not in the door itself, where a
+    // replan would otherwise turn the robot against the jambs.
+    const bool align = LegIsNarrow(map, params, vertices[0], vertices[1]) &&
+                       map.ClearanceAt(vertices[0]) >= params.turn_clearance_m;
+    const double limit_deg = align ? std::min(kAlignBeforeNarrowDeg, params.turn_in_place_deg)
+                                   : params.turn_in_place_deg;
     if (std::abs(error) > DegToRad(limit_deg)) {
       path.front().turn_in_place = true;
       path.front().speed_mps = 0.0;
