@@ -60,12 +60,6 @@ constexpr double kMaxBackOutM = 1.0;
 // robot's direction, degrees.
 constexpr double kReverseDeg = 90.0;
 
-// At a goal reached, the robot turns to face its frontier point when it lies
-// more than this off the heading (the laser sees 90 deg either side),
-// degrees; the turn ends within kFacedRad.
-constexpr double kFaceFrontierDeg = 45.0;
-constexpr double kFacedRad = 0.1;
-
 // Whether no occupied cell lies on the segment from `from_W` to `to_W` (the
 // cell of `to_W` excluded): a viewpoint must see its frontier point.
 bool SeesPoint(const OccupancyGrid& grid, const Eigen::Vector2d& from_W,
@@ -131,7 +125,6 @@ void Explorer::DropGoal(bool blacklist, bool failed) {
   }
   has_goal_ = false;
   backing_out_ = false;
-  facing_ = false;
   tracker_.Clear();
   ++log_version_;
 }
@@ -182,20 +175,6 @@ bool Explorer::PlanToGoal(const NavigationMap& map, const Pose2& X_WR, double t_
   tracker_.SetPath(std::move(path));
   ++log_version_;
   return true;
-}
-
-Twist2 Explorer::FaceFrontier(const Pose2& X_WR, double dt_s) {
-  const Eigen::Vector2d to = frontier_W_ - X_WR.translation();
-  const double error = WrapAngle(std::atan2(to.y(), to.x()) - X_WR.theta);
-  if (std::abs(error) < kFacedRad) {
-    DropGoal(true, false);
-    return tracker_.last_command();
-  }
-  const Twist2 target = SaturateKeepingCurvature(
-      {0.0, params_.turn_gain_per_s * error}, params_.max_linear_speed_mps,
-      params_.max_angular_speed_radps);
-  return RateLimit(tracker_.last_command(), target, params_.max_linear_accel_mps2 * dt_s,
-                   params_.max_angular_accel_radps2 * dt_s);
 }
 
 Twist2 Explorer::BackOut(const Pose2& X_WR, double t_s, double dt_s) {
@@ -361,15 +340,8 @@ Twist2 Explorer::InitialTurn(const Pose2& X_WR, double dt_s) {
 }
 
 void Explorer::CheckGoal(const Pose2& X_WR, bool new_scan, double t_s) {
-  // Reached (after facing the frontier point: the goal's viewpoint may lie
-  // beside it, e.g. at the mouth of a narrow strip seen only along its
-  // length), explored meanwhile, failed (no progress, or blocked too long).
-  if (has_goal_ && tracker_.done() && !facing_) {
-    const Eigen::Vector2d to = frontier_W_ - X_WR.translation();
-    facing_ = std::abs(WrapAngle(std::atan2(to.y(), to.x()) - X_WR.theta)) >
-              DegToRad(kFaceFrontierDeg);
-    if (!facing_) DropGoal(true, false);
-  }
+  // Reached, explored meanwhile, failed (no progress, or blocked too long).
+  if (has_goal_ && tracker_.done()) DropGoal(true, false);
   if (has_goal_ && new_scan &&
       InformationGain(grid_, frontier_W_, params_.gain_radius_m) < params_.min_gain_m2) {
     DropGoal(false);
@@ -489,12 +461,10 @@ ExplorerOutput Explorer::Step(const Pose2& X_WR, const LaserScan* scan, const Po
     CheckGoal(X_WR, scan != nullptr, t_s);
     if (!has_goal_) {
       ChooseGoal(X_WR, t_s);
-    } else if (!facing_ &&
-               (ScanBlocksPath() || t_s - last_plan_t_s_ >= params_.replan_period_s)) {
+    } else if (ScanBlocksPath() || t_s - last_plan_t_s_ >= params_.replan_period_s) {
       Replan(X_WR, t_s);
     }
-    if (!finished_ && facing_) command = FaceFrontier(X_WR, dt_s);
-    if (!finished_ && !backing_out_ && !facing_) command = tracker_.Command(X_WR, dt_s);
+    if (!finished_ && !backing_out_) command = tracker_.Command(X_WR, dt_s);
     if (!finished_ && backing_out_) command = BackOut(X_WR, t_s, dt_s);
   }
 

@@ -158,9 +158,6 @@ class Explorer {
   // has turn_clearance_m, has backed 1 m, or the safety layer holds it; then
   // replans and returns the last command.
   Twist2 BackOut(const Pose2& X_WR, double t_s, double dt_s);
-  // One step of turning in place to face the frontier point at a goal
-  // reached; drops the goal as reached once facing it.
-  Twist2 FaceFrontier(const Pose2& X_WR, double dt_s);
   // Drops the current goal; blacklists it when `blacklist`, as failed when
   // `failed` (otherwise as reached).
   void DropGoal(bool blacklist, bool failed = true);
@@ -208,8 +205,6 @@ class Explorer {
   // Backing out of a narrow place before a path that reverses direction,
   // and where the axle was when it began.
   bool backing_out_ = false;
-  // Turning to face the frontier point at the goal reached.
-  bool facing_ = false;
   Eigen::Vector2d back_out_from_W_ = Eigen::Vector2d::Zero();
 
   double turned_rad_ = 0.0;
