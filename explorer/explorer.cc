@@ -7,6 +7,7 @@
 
 #include "common/angles.h"
 #include "common/check.h"
+#include "common/grid2.h"
 #include "explorer/frontiers.h"
 #include "explorer/point_h_controller.h"
 
@@ -52,6 +53,26 @@ constexpr double kRecoverySpeedMps = 0.1;
 constexpr double kRecoveryTurnRadps = 0.4;
 // The first cost bound of the search for a goal, metres (then doubled).
 constexpr double kFirstSearchCostM = 4.0;
+// A robot that backs out of a narrow place stops after this distance even
+// without turning room, metres.
+constexpr double kMaxBackOutM = 1.0;
+// A path that starts with a turn in place of more than this reverses the
+// robot's direction, degrees.
+constexpr double kReverseDeg = 90.0;
+
+// Whether no occupied cell lies on the segment from `from_W` to `to_W` (the
+// cell of `to_W` excluded): a viewpoint must see its frontier point.
+bool SeesPoint(const OccupancyGrid& grid, const Eigen::Vector2d& from_W,
+               const Eigen::Vector2d& to_W) {
+  const Eigen::Vector2i last = grid.CellOf(to_W);
+  bool clear = true;
+  TraverseSegment(grid.limits(), from_W, to_W, [&](int ix, int iy) {
+    if (Eigen::Vector2i(ix, iy) != last && grid.State(ix, iy) == CellState::kOccupied) {
+      clear = false;
+    }
+  });
+  return clear;
+}
 
 }  // namespace
 
@@ -103,6 +124,7 @@ void Explorer::DropGoal(bool blacklist, bool failed) {
     blacklist_failed_.push_back(failed ? 1 : 0);
   }
   has_goal_ = false;
+  backing_out_ = false;
   tracker_.Clear();
   ++log_version_;
 }
@@ -131,22 +153,46 @@ Eigen::Vector2d Explorer::AxleOf(const Pose2& X_WR) const {
   return X_WR * Eigen::Vector2d(-a_m_, 0.0);
 }
 
-double Explorer::RemainingPath(const Pose2& X_WR) const {
-  const Path& path = tracker_.path();
-  if (path.empty()) return 0.0;
-  const PathPoint& near = path[tracker_.index()];
-  return path.back().s_m - near.s_m + (near.p_W - X_WR.translation()).norm();
-}
-
 bool Explorer::PlanToGoal(const NavigationMap& map, const Pose2& X_WR, double t_s) {
   // The plan is the axle's (its clearance covers the body in every
   // heading); the tracker follows the path of h that goes with it.
-  Path path = PathOfPointH(PlanPath(map, params_, goal_W_, X_WR.theta), a_m_, X_WR.theta);
+  const Path axle_path = PlanPath(map, params_, goal_W_, X_WR.theta);
   last_plan_t_s_ = t_s;
-  if (path.empty()) return false;
+  if (axle_path.empty()) return false;
+  // Progress: the axle's path to the goal, planned from where the axle is,
+  // got shorter (turning in place or swinging h is none).
+  if (axle_path.back().s_m < best_remaining_m_ - params_.progress_min_m) {
+    best_remaining_m_ = axle_path.back().s_m;
+    progress_t_s_ = t_s;
+  }
+  Path path = PathOfPointH(axle_path, a_m_, X_WR.theta);
+  // A path that reverses the robot's direction from a place where it cannot
+  // turn (a door, a narrow strip): back out straight first, the way it came.
+  const double turn = std::abs(WrapAngle(path.front().heading_rad - X_WR.theta));
+  backing_out_ = path.front().turn_in_place && turn > DegToRad(kReverseDeg) &&
+                 map.ClearanceAt(AxleOf(X_WR)) < params_.turn_clearance_m;
+  if (backing_out_) back_out_from_W_ = AxleOf(X_WR);
   tracker_.SetPath(std::move(path));
   ++log_version_;
   return true;
+}
+
+Twist2 Explorer::BackOut(const Pose2& X_WR, double t_s, double dt_s) {
+  clearance_.Update(grid_);
+  const Eigen::Vector2d axle = AxleOf(X_WR);
+  const Eigen::Vector2i cell = grid_.CellOf(axle);
+  const bool room = grid_.Contains(cell.x(), cell.y()) &&
+                    clearance_.Clearance(cell.x(), cell.y()) >= params_.turn_clearance_m;
+  if (room || (axle - back_out_from_W_).norm() >= kMaxBackOutM || blocked_s_ > 0.0) {
+    backing_out_ = false;
+    // Backing out to turning room is a manoeuvre, not a lack of progress.
+    if (room) progress_t_s_ = t_s;
+    Replan(X_WR, t_s);
+    return tracker_.last_command();
+  }
+  const Twist2 target{-params_.narrow_speed_mps, 0.0};
+  return RateLimit(tracker_.last_command(), target, params_.max_linear_accel_mps2 * dt_s,
+                   params_.max_angular_accel_radps2 * dt_s);
 }
 
 std::vector<Explorer::Candidate> Explorer::ScoreFrontiers(
@@ -212,11 +258,14 @@ double Explorer::BestViewpoint(const NavigationMap& map, const Eigen::Vector2d& 
   for (int iy = c.y() - window; iy <= c.y() + window; ++iy) {
     for (int ix = c.x() - window; ix <= c.x() + window; ++ix) {
       const double cost = map.CostTo(ix, iy);
-      if (!std::isfinite(cost) || !map.Comfortable(ix, iy)) continue;
+      if (!std::isfinite(cost) || !map.Comfortable(ix, iy) ||
+          map.Clearance(ix, iy) < params_.turn_clearance_m) {
+        continue;
+      }
       const Eigen::Vector2d cell = grid_.CellCenter(ix, iy);
       const double distance = (cell - p_W).norm();
       if (distance > params_.view_distance_m) continue;
-      if (cost + 2.0 * distance < best) {
+      if (cost + 2.0 * distance < best && SeesPoint(grid_, cell, p_W)) {
         best = cost + 2.0 * distance;
         *viewpoint_W = cell;
       }
@@ -246,9 +295,8 @@ void Explorer::ChooseGoal(const Pose2& X_WR, double t_s) {
     frontier_W_ = candidate.frontier_W;
     goal_W_ = candidate.goal_W;
     has_goal_ = true;
+    best_remaining_m_ = std::numeric_limits<double>::infinity();
     if (PlanToGoal(map, X_WR, t_s)) {
-      best_remaining_m_ = RemainingPath(X_WR);
-      progress_t_s_ = t_s;
       blocked_total_s_ = 0.0;
       return;
     }
@@ -299,11 +347,6 @@ void Explorer::CheckGoal(const Pose2& X_WR, bool new_scan, double t_s) {
     DropGoal(false);
   }
   if (has_goal_) {
-    const double remaining = RemainingPath(X_WR);
-    if (remaining < best_remaining_m_ - params_.progress_min_m) {
-      best_remaining_m_ = remaining;
-      progress_t_s_ = t_s;
-    }
     if (t_s - progress_t_s_ > params_.progress_timeout_s ||
         blocked_total_s_ > params_.blocked_timeout_s) {
       DropGoal(true);
@@ -331,11 +374,7 @@ void Explorer::Replan(const Pose2& X_WR, double t_s) {
   // A* to the goal only: the search's cost follows the path, not the map.
   NavigationMap map(grid_, clearance_, params_, AxleOf(X_WR), NavigationMap::Search::kOnDemand);
   map.SearchTo(grid_.CellOf(goal_W_));
-  const double remaining_before = best_remaining_m_;
-  if (PlanToGoal(map, X_WR, t_s)) {
-    // Keep the progress clock: a new plan is not progress.
-    best_remaining_m_ = std::min(remaining_before, RemainingPath(X_WR));
-  } else {
+  if (!PlanToGoal(map, X_WR, t_s)) {
     DropGoal(true);
     ChooseGoal(X_WR, t_s);
   }
@@ -390,7 +429,12 @@ ExplorerOutput Explorer::SafeOutput(const Twist2& wanted, const Pose2& X_WR, dou
   bool limited = false;
   command = SafetyFilter(command, X_WR, obstacles, params_, a_m_, dt_s, &limited);
   tracker_.set_last_command(command);
-  if (limited && std::abs(command.v_mps) < 1e-3 && std::abs(command.w_radps) < 1e-3) {
+  // Held still, or held from driving on (only a turn in place left where
+  // the robot wanted to drive: at a door's jamb, a turn that never ends).
+  const bool held_from_driving = std::abs(wanted.v_mps) >= 1e-3 &&
+                                 std::abs(command.v_mps) < 1e-3;
+  if (limited && (held_from_driving ||
+                  (std::abs(command.v_mps) < 1e-3 && std::abs(command.w_radps) < 1e-3))) {
     blocked_s_ += dt_s;
     blocked_total_s_ += dt_s;
   } else {
@@ -412,14 +456,16 @@ ExplorerOutput Explorer::Step(const Pose2& X_WR, const LaserScan* scan, const Po
   // the goal (kept, replaced or replanned first).
   Twist2 command;
   if (phase_ == Phase::kInitialTurn) command = InitialTurn(X_WR, dt_s);
-  if (phase_ == Phase::kExploring) {
+  if (phase_ == Phase::kExploring && backing_out_) command = BackOut(X_WR, t_s, dt_s);
+  if (phase_ == Phase::kExploring && !backing_out_) {
     CheckGoal(X_WR, scan != nullptr, t_s);
     if (!has_goal_) {
       ChooseGoal(X_WR, t_s);
     } else if (ScanBlocksPath() || t_s - last_plan_t_s_ >= params_.replan_period_s) {
       Replan(X_WR, t_s);
     }
-    if (!finished_) command = tracker_.Command(X_WR, dt_s);
+    if (!finished_ && !backing_out_) command = tracker_.Command(X_WR, dt_s);
+    if (!finished_ && backing_out_) command = BackOut(X_WR, t_s, dt_s);
   }
 
   if (finished_) {

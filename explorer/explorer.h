@@ -117,7 +117,7 @@ class Explorer {
   Twist2 InitialTurn(const Pose2& X_WR, double dt_s);
   // Drops the goal when it is reached, explored meanwhile (`new_scan` only),
   // or failed (no progress within progress_timeout_s, blocked for
-  // blocked_timeout_s); tracks the progress along the path.
+  // blocked_timeout_s; progress is measured at each plan, see PlanToGoal).
   void CheckGoal(const Pose2& X_WR, bool new_scan, double t_s);
   // Whether an echo of the last scan lies on the path ahead (between
   // kPathCheckSkipM and kPathCheckRangeM along it) within the body's half
@@ -150,8 +150,14 @@ class Explorer {
   // `viewpoint_W` (untouched when there is none: the cost is infinite).
   double BestViewpoint(const NavigationMap& map, const Eigen::Vector2d& p_W,
                        Eigen::Vector2d* viewpoint_W) const;
-  // Plans a path to the current goal; false when there is none.
+  // Plans a path to the current goal; false when there is none. Starts a
+  // back-out when the path reverses the robot's direction (a turn in place
+  // of more than 90 deg first) where the axle lacks turn_clearance_m.
   bool PlanToGoal(const NavigationMap& map, const Pose2& X_WR, double t_s);
+  // One step of backing out straight (at narrow_speed_mps) until the axle
+  // has turn_clearance_m, has backed 1 m, or the safety layer holds it; then
+  // replans and returns the last command.
+  Twist2 BackOut(const Pose2& X_WR, double t_s, double dt_s);
   // Drops the current goal; blacklists it when `blacklist`, as failed when
   // `failed` (otherwise as reached).
   void DropGoal(bool blacklist, bool failed = true);
@@ -162,8 +168,6 @@ class Explorer {
   std::vector<Eigen::Vector2d> NearbyObstacles(const Pose2& X_WR) const;
   // The centre of the axle, a_m behind h: the point the planner plans for.
   Eigen::Vector2d AxleOf(const Pose2& X_WR) const;
-  // Remaining length of the path from h, metres.
-  double RemainingPath(const Pose2& X_WR) const;
 
   ExplorerParams params_;
   double a_m_;
@@ -185,6 +189,8 @@ class Explorer {
   Eigen::Vector2d frontier_W_ = Eigen::Vector2d::Zero();
   Eigen::Vector2d goal_W_ = Eigen::Vector2d::Zero();
   double last_plan_t_s_ = 0.0;
+  // The shortest axle path to the goal planned so far (each plan starts at
+  // the axle), and when it last got progress_min_m shorter.
   double best_remaining_m_ = 0.0;
   double progress_t_s_ = 0.0;
   // Time the safety layer has held the robot still: in a row (triggers a
@@ -195,6 +201,11 @@ class Explorer {
   double recovery_until_s_ = -1.0;
   // Index of the escape motion of the current recovery, or -1.
   int recovery_escape_ = -1;
+
+  // Backing out of a narrow place before a path that reverses direction,
+  // and where the axle was when it began.
+  bool backing_out_ = false;
+  Eigen::Vector2d back_out_from_W_ = Eigen::Vector2d::Zero();
 
   double turned_rad_ = 0.0;
   double last_theta_ = 0.0;

@@ -25,6 +25,9 @@ std::vector<ParamProblem> ExplorerParams::Validate() const {
   check.Require(preferred_clearance_m >= clearance_m, "preferred_clearance_m",
                 preferred_clearance_m, "a value >= clearance_m");
   check.NonNegative("clearance_cost_weight", clearance_cost_weight);
+  check.NonNegative("narrow_cost_weight", narrow_cost_weight);
+  check.Require(turn_clearance_m >= clearance_m, "turn_clearance_m", turn_clearance_m,
+                "a value >= clearance_m");
   check.NonNegative("escape_radius_m", escape_radius_m);
   check.Positive("min_turn_radius_m", min_turn_radius_m);
   check.Require(max_turn_radius_m >= min_turn_radius_m, "max_turn_radius_m",
@@ -61,6 +64,8 @@ std::vector<ParamProblem> ExplorerParams::Validate() const {
   check.InRange("turn_in_place_deg", turn_in_place_deg, 1.0, 180.0);
   check.Positive("turn_gain_per_s", turn_gain_per_s);
   check.NonNegative("safety_margin_m", safety_margin_m);
+  check.Require(safety_margin_slow_m >= 0.0 && safety_margin_slow_m <= safety_margin_m,
+                "safety_margin_slow_m", safety_margin_slow_m, "a value in [0, safety_margin_m]");
   check.Positive("brake_decel_mps2", brake_decel_mps2);
   check.Positive("safety_range_m", safety_range_m);
   return check.problems();

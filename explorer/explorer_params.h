@@ -58,6 +58,17 @@ struct ExplorerParams {
   /// Weight of that extra cost: a step at zero clearance costs (1 + weight)
   /// times its length.
   double clearance_cost_weight = 3.0;
+  /// Extra weight of a step in a narrow place (a door: clearance below
+  /// `clearance_m` + 0.15 m): a step at `clearance_m` costs this much more
+  /// per metre, falling linearly to 0 at `clearance_m` + 0.15 m, so that a
+  /// path crosses a door on its clearance ridge (its middle), not a few
+  /// centimetres off it.
+  double narrow_cost_weight = 10.0;
+  /// Clearance of the axle needed to turn in place (the rear corners reach
+  /// 0.328 m from it; with the slow safety margin and half a cell, 0.40),
+  /// metres: goals (viewpoints) need it; a robot without it that must
+  /// reverse its direction backs out straight instead of turning.
+  double turn_clearance_m = 0.40;
   /// Around the robot's start of a plan, cells with less clearance are
   /// allowed (to leave a tight spot), within this radius, metres.
   double escape_radius_m = 0.6;
@@ -130,6 +141,12 @@ struct ExplorerParams {
   // --- Safety layer ---
   /// Extra margin around the body that the safety layer keeps free, metres.
   double safety_margin_m = 0.05;
+  /// The margin of a robot at rest, metres: the margin grows linearly with the
+  /// speed of the body's fastest point (|v| + 0.33 m x |w|) from this value to
+  /// `safety_margin_m` at 0.3 m/s, so that a creeping robot can pass a 0.8 m
+  /// door (0.1375 m a side with its wheels) on a path a few centimetres off
+  /// its middle.
+  double safety_margin_slow_m = 0.02;
   /// Deceleration assumed for a stop, m/s^2.
   double brake_decel_mps2 = 0.8;
   /// Obstacle points (scan echoes, occupied cells) within this distance of h
@@ -156,6 +173,8 @@ struct ExplorerParams {
     a->Visit(MJSLAM_NVP(clearance_m));
     a->Visit(MJSLAM_NVP(preferred_clearance_m));
     a->Visit(MJSLAM_NVP(clearance_cost_weight));
+    a->Visit(MJSLAM_NVP(narrow_cost_weight));
+    a->Visit(MJSLAM_NVP(turn_clearance_m));
     a->Visit(MJSLAM_NVP(escape_radius_m));
     a->Visit(MJSLAM_NVP(min_turn_radius_m));
     a->Visit(MJSLAM_NVP(max_turn_radius_m));
@@ -185,6 +204,7 @@ struct ExplorerParams {
     a->Visit(MJSLAM_NVP(turn_in_place_deg));
     a->Visit(MJSLAM_NVP(turn_gain_per_s));
     a->Visit(MJSLAM_NVP(safety_margin_m));
+    a->Visit(MJSLAM_NVP(safety_margin_slow_m));
     a->Visit(MJSLAM_NVP(brake_decel_mps2));
     a->Visit(MJSLAM_NVP(safety_range_m));
   }

@@ -106,6 +106,14 @@ void NavigationMap::Start(Search search) {
   if (search == Search::kFull) ExpandTo(kInfinity);
 }
 
+double NavigationMap::StepCostFactor(double clearance_m) const {
+  const double shortfall =
+      std::max(0.0, params_.preferred_clearance_m - clearance_m) / params_.preferred_clearance_m;
+  const double narrow =
+      std::max(0.0, params_.clearance_m + kNarrowMarginM - clearance_m) / kNarrowMarginM;
+  return 1.0 + params_.clearance_cost_weight * shortfall + params_.narrow_cost_weight * narrow;
+}
+
 bool NavigationMap::SettleNext(int goal) {
   static constexpr int dx[8] = {1, -1, 0, 0, 1, 1, -1, -1};
   static constexpr int dy[8] = {0, 0, 1, -1, 1, -1, 1, -1};
@@ -140,11 +148,7 @@ bool NavigationMap::SettleNext(int goal) {
       // Diagonal moves must not cut the corner of a blocked cell.
       if (k >= 4 && (!Traversable(ix + dx[k], iy) || !Traversable(ix, iy + dy[k]))) continue;
       const int j = grid_.Index(jx, jy);
-      const double shortfall =
-          std::max(0.0, params_.preferred_clearance_m - (*clearance_)[j]) /
-          params_.preferred_clearance_m;
-      const double step = (k < 4 ? r : r * std::sqrt(2.0)) *
-                          (1.0 + params_.clearance_cost_weight * shortfall);
+      const double step = (k < 4 ? r : r * std::sqrt(2.0)) * StepCostFactor((*clearance_)[j]);
       // Compared as stored (float): a double compared with its own rounding
       // would re-push a cell at an equal cost, without end.
       const float next = static_cast<float>(cost + step);
@@ -416,9 +420,12 @@ Path PlanPath(const NavigationMap& map, const ExplorerParams& params,
   // Turn toward the first leg first when it leaves far off the heading.
   if (path.size() >= 2) {
     const double error = WrapAngle(path.front().heading_rad - heading_rad);
-    const double limit_deg = LegIsNarrow(map, params, vertices[0], vertices[1])
-                                 ? std::min(kAlignBeforeNarrowDeg, params.turn_in_place_deg)
-                                 : params.turn_in_place_deg;
+    // Where the axle has room to turn: not in the door itself, where a
+    // replan would otherwise turn the robot against the jambs.
+    const bool align = LegIsNarrow(map, params, vertices[0], vertices[1]) &&
+                       map.ClearanceAt(vertices[0]) >= params.turn_clearance_m;
+    const double limit_deg = align ? std::min(kAlignBeforeNarrowDeg, params.turn_in_place_deg)
+                                   : params.turn_in_place_deg;
     if (std::abs(error) > DegToRad(limit_deg)) {
       path.front().turn_in_place = true;
       path.front().speed_mps = 0.0;

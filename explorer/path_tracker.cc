@@ -25,6 +25,11 @@ constexpr double kSearchWindowM = 1.5;
 // about 0.03 s in the office runs); the safety layer predicts each command held
 // this much longer than the control period, seconds.
 constexpr double kWheelLagS = 0.05;
+// The body's farthest point from the axle (a rear corner), metres: its speed
+// in a turn is this times |w|.
+constexpr double kBodyReachM = 0.33;
+// Speed of the body's fastest point at which the safety margin is whole, m/s.
+constexpr double kFullMarginSpeedMps = 0.3;
 
 }  // namespace
 
@@ -191,12 +196,18 @@ bool PredictedContact(const Twist2& command, const Pose2& X_WR,
 
 }  // namespace
 
+double SafetyMarginM(const Twist2& command, const ExplorerParams& params) {
+  const double speed = std::abs(command.v_mps) + kBodyReachM * std::abs(command.w_radps);
+  const double fraction = std::min(1.0, speed / kFullMarginSpeedMps);
+  return params.safety_margin_slow_m +
+         fraction * (params.safety_margin_m - params.safety_margin_slow_m);
+}
+
 Twist2 SafetyFilter(const Twist2& command, const Pose2& X_WR,
                     const std::vector<Eigen::Vector2d>& obstacles_W,
                     const ExplorerParams& params, double a_m, double dt_s, bool* limited) {
-  const double margin =
-      BodyTouches(X_WR, obstacles_W, params, params.safety_margin_m) ? 0.0
-                                                                     : params.safety_margin_m;
+  // A robot already inside the slow margin may still move (away).
+  const bool inside = BodyTouches(X_WR, obstacles_W, params, params.safety_margin_slow_m);
   const Twist2 candidates[] = {command,
                                {0.5 * command.v_mps, command.w_radps},
                                {command.v_mps, 0.0},
@@ -205,6 +216,7 @@ Twist2 SafetyFilter(const Twist2& command, const Pose2& X_WR,
                                {0.0, 0.0}};
   if (limited != nullptr) *limited = false;
   for (const Twist2& candidate : candidates) {
+    const double margin = inside ? 0.0 : SafetyMarginM(candidate, params);
     if (!PredictedContact(candidate, X_WR, obstacles_W, params, a_m, dt_s, margin)) {
       if (limited != nullptr) {
         *limited = candidate.v_mps != command.v_mps || candidate.w_radps != command.w_radps;

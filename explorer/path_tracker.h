@@ -52,13 +52,20 @@ class PathTracker {
   Twist2 last_;
 };
 
+/// The safety margin for a command, metres: `safety_margin_slow_m` at rest,
+/// growing linearly with the speed of the body's fastest point (|v| + 0.33 m
+/// x |w|) to `safety_margin_m` at 0.3 m/s.
+double SafetyMarginM(const Twist2& command, const ExplorerParams& params);
+
 /// The safety layer. Predicts the body of the robot (the rectangle of
-/// ExplorerParams' body_* fields grown by `safety_margin_m`) under `command`
+/// ExplorerParams' body_* fields and the wheel discs, grown by the margin
+/// SafetyMarginM gives each command tried) under `command`
 /// held for `dt_s` and then braking at `brake_decel_mps2` (the yaw rate
 /// braking in proportion), and checks it against `obstacles_W` (scan echoes
 /// and occupied cells near the robot). When the prediction touches an
 /// obstacle it tries, in order, half the speed, no turn, half the speed and
-/// no turn, turning in place, a full stop. When the body is already within the margin of an obstacle,
+/// no turn, turning in place, a full stop. When the body is already within
+/// the slow margin of an obstacle,
 /// only actual contact is checked, so the robot can still move away.
 /// `a_m` is the offset of h ahead of the axle; `limited` (optional) tells
 /// whether the command was changed.

@@ -120,6 +120,7 @@ TEST(SafetyFilterTest, LongCommandPeriodStopsEarlier) {
 
 TEST(SafetyFilterTest, WheelDiscsArePartOfTheFootprint) {
   ExplorerParams params;
+  params.safety_margin_slow_m = params.safety_margin_m;  // the same margin at every speed
   // Beside the right wheel, outside the body rectangle (|y| > 0.19) but
   // inside the wheel's collision disc (0.165 + 0.0975 = 0.2625).
   const std::vector<Eigen::Vector2d> beside{{-0.2025, -0.24}};
@@ -139,6 +140,37 @@ TEST(SafetyFilterTest, WheelDiscsArePartOfTheFootprint) {
   const Twist2 u = SafetyFilter({-0.1, 0.0}, Pose2(), jamb, params, 0.2025, 0.3, &limited);
   EXPECT_TRUE(limited);
   EXPECT_GT(u.v_mps, -0.1);  // slower or stopped
+}
+
+// The margin shrinks with speed: a robot creeping through a 0.8 m door
+// 9.75 cm off its middle (a path a few cm off, occupied cells up to half a
+// cell into the opening; the wheels reach 0.2625 m, so 0.04 m is left on the
+// near side) may go on; at cruise speed, or with the whole margin at every
+// speed (the former rule), the safety layer stops it.
+TEST(SafetyFilterTest, CreepingThroughAStandardDoorKeepsASmallerMargin) {
+  ExplorerParams params;
+  EXPECT_EQ(SafetyMarginM({0.0, 0.0}, params), params.safety_margin_slow_m);
+  EXPECT_EQ(SafetyMarginM({0.4, 0.0}, params), params.safety_margin_m);
+  EXPECT_EQ(SafetyMarginM({0.0, 1.0}, params), params.safety_margin_m);
+  EXPECT_LT(SafetyMarginM({0.1, 0.0}, params), SafetyMarginM({0.2, 0.0}, params));
+  // Jambs 0.15 m deep at y = 0.3025 and -0.4975, from 6.5 cm ahead of the
+  // wheels' axle: the left wheel's disc is 0.052 m from the jamb's corner,
+  // and within the whole margin of it after 2 cm more.
+  std::vector<Eigen::Vector2d> jambs;
+  for (double x = -0.1375; x <= 0.0125 + 1e-9; x += 0.01) {
+    jambs.emplace_back(x, 0.3025);
+    jambs.emplace_back(x, -0.4975);
+  }
+  bool limited = false;
+  const Twist2 creep = SafetyFilter({0.1, 0.0}, Pose2(), jambs, params, 0.2025, 0.1, &limited);
+  EXPECT_FALSE(limited);
+  EXPECT_EQ(creep.v_mps, 0.1);
+  SafetyFilter({0.4, 0.0}, Pose2(), jambs, params, 0.2025, 0.1, &limited);
+  EXPECT_TRUE(limited);
+  ExplorerParams fixed = params;
+  fixed.safety_margin_slow_m = fixed.safety_margin_m;
+  SafetyFilter({0.1, 0.0}, Pose2(), jambs, fixed, 0.2025, 0.1, &limited);
+  EXPECT_TRUE(limited);
 }
 
 TEST(ExplorerParamsTest, DefaultsAreValidAndBadValuesAreNamed) {
