@@ -6,6 +6,8 @@ slam.ekf.lateral_skid_s and slam.ekf.lateral_slip_std_m_per_rad
 
     scripts/calibrate_noise.py DIR [DIR ...] [--offset A] [--window L] [--no-gain] [--no-lag]
                                [--json FILE]
+    scripts/calibrate_noise.py --consistency WORK --write CONFIG [--config BASE] [--seed S]
+                               [--runs N] [--jobs J] [--iterations K] [--tolerance T]
 
 Each DIR is a run directory (with trajectory.csv) or a sweep directory (its
 runs/run_*/ are taken). For every step k of a trajectory (rows k-1 and k,
@@ -49,7 +51,24 @@ an arc along the mid-arc heading, plus a sideways skid):
 Prints the fitted values as the YAML of configs/default.yaml's slam.ekf
 section, and for each fit the mean of (error / sigma)^2 (1 for a model that
 fits) over bins of the inputs, so that a model that does not fit shows.
-Python 3 standard library only.
+
+Consistency scale (--consistency WORK --write CONFIG): white motion noise fitted
+from the true motion leaves the filters overconfident, because the linearised
+EKF gains information from its corrections that it does not have
+(docs/method.md, "Calibrating the process noise"). This mode runs the whole
+procedure: a training sweep with --config (WORK/motion: --runs runs from
+--seed), the fit above on it, then sweeps of the same seeds with the fitted
+model (WORK/scale_N) that set the two factors
+slam.ekf.command_noise.v_noise_scale and w_noise_scale so that the training
+runs' mean pose NEES per component is its dof: the position's (x, y; 2 dof)
+sets the speed's factor, the heading's (1 dof) the turn rate's, each
+multiplied by the square root of its mean NEES per dof (both filters' steps
+pooled) until both are within --tolerance of 1 or --iterations sweeps are
+done. CONFIG gets --config with the fitted values and the factors
+(PyYAML). Sweeps whose sweep.json exists in WORK are reused. Never give it
+the seeds a result is evaluated on.
+
+Python 3 standard library only (the consistency mode: python3-yaml too).
 """
 import argparse
 import csv
@@ -57,6 +76,7 @@ import glob
 import json
 import math
 import os
+import subprocess
 import sys
 
 
@@ -376,9 +396,158 @@ def print_bins(title, steps, key, edges, normalised):
         print(f"    {key} in [{lo:g}, {hi:g}): {len(chosen):6d} steps, mean (e/sigma)^2 = {mean:.2f}")
 
 
+def read_runs(dirs, offset):
+    """(runs_steps, steps, skid c, slip k) of the runs in `dirs`; raises
+    OSError or ValueError naming the file."""
+    runs = run_dirs(dirs)
+    runs_steps = [read_steps(run, offset) for run in runs]
+    steps = [s for run_steps in runs_steps for s in run_steps]
+    if len(steps) < 100:
+        raise ValueError(f"only {len(steps)} steps in {len(runs)} runs: too few to fit")
+    c, k = fit_skid(steps)
+    return runs_steps, steps, c, k
+
+
+COMMAND_NAMES = ["v_noise_std_mps", "v_noise_fraction", "w_noise_std_radps", "w_noise_fraction",
+                 "change_noise_fraction"]
+ODOMETRY_NAMES = ["distance_noise_std_m", "distance_noise_std_m_per_sqrt_m",
+                  "heading_noise_std_rad", "heading_noise_std_rad_per_sqrt_m",
+                  "heading_noise_std_rad_per_sqrt_rad"]
+
+
+def ekf_values(gains, lag, command, odometry, c, k):
+    """The fitted values as the keys of slam.ekf (nested dicts)."""
+    return {"command_gain_v": gains[0], "command_gain_w": gains[1], "command_lag_s": lag,
+            "command_noise": dict(zip(COMMAND_NAMES, command)),
+            "odometry_noise": dict(zip(ODOMETRY_NAMES, odometry)),
+            "lateral_skid_s": c, "lateral_slip_std_m_per_rad": k}
+
+
+def set_overrides(values, prefix="slam.ekf"):
+    """--set arguments of mjslam for nested `values` under `prefix`."""
+    out = []
+    for key, value in values.items():
+        if isinstance(value, dict):
+            out += set_overrides(value, f"{prefix}.{key}")
+        else:
+            out += ["--set", f"{prefix}.{key}={value!r}"]
+    return out
+
+
+def sweep(args, out, overrides):
+    """Runs (or reuses, when out/sweep.json exists) a training sweep."""
+    if os.path.isfile(os.path.join(out, "sweep.json")):
+        print(f"# reusing {out}", flush=True)
+        return
+    command = [args.mjslam, "sweep", "--runs", str(args.runs), "--jobs", str(args.jobs),
+               "--out", out, "--config", args.config, "--set", f"run.seed={args.seed}",
+               "--set", "render.enabled=false"] + overrides
+    print("# " + " ".join(command), flush=True)
+    with open(out + ".log", "w") as log:
+        result = subprocess.run(command, stdout=log, stderr=subprocess.STDOUT)
+    if result.returncode != 0:
+        raise ValueError(f"{' '.join(command)}: exit status {result.returncode} (log: {out}.log)")
+
+
+def pose_nees_per_dof(dirs):
+    """(position, heading) mean NEES per dof over every step of the runs in
+    `dirs` and both filters whose pose covariance is positive definite: the
+    mean of e_xy' P_xy^-1 e_xy / 2 and of e_th^2 / P_thth. Also the count."""
+    position = heading = 0.0
+    count = 0
+    for run in run_dirs(dirs):
+        path = os.path.join(run, "trajectory.csv")
+        with open(path) as f:
+            for line, r in enumerate(csv.DictReader(f), start=2):
+                try:
+                    for name in ("classical", "selective"):
+                        pxx, pxy, pyy, ptt = (float(r[f"{name}_{k}"])
+                                              for k in ("pxx", "pxy", "pyy", "pthth"))
+                        det = pxx * pyy - pxy * pxy
+                        if pxx <= 0.0 or det <= 0.0 or ptt <= 0.0:
+                            continue
+                        ex = float(r[f"{name}_x"]) - float(r["true_x"])
+                        ey = float(r[f"{name}_y"]) - float(r["true_y"])
+                        eth = math.remainder(float(r[f"{name}_th"]) - float(r["true_th"]),
+                                             2.0 * math.pi)
+                        position += (pyy * ex * ex - 2.0 * pxy * ex * ey + pxx * ey * ey) / det / 2
+                        heading += eth * eth / ptt
+                        count += 1
+                except (KeyError, ValueError) as e:
+                    raise ValueError(f"{path}:{line}: {e}") from None
+    if count == 0:
+        raise ValueError(f"{dirs}: no step with a positive definite pose covariance")
+    return position / count, heading / count, count
+
+
+def write_config(args, values, history):
+    """Writes --config with slam.ekf set from `values` to --write."""
+    import yaml  # python3-yaml; only this mode needs it
+    with open(args.config) as f:
+        config = yaml.safe_load(f) or {}
+    ekf = config.setdefault("slam", {}).setdefault("ekf", {})
+    for key, value in values.items():
+        if isinstance(value, dict):
+            ekf.setdefault(key, {}).update({k: float(f"{v:.4g}") for k, v in value.items()})
+        else:
+            ekf[key] = float(f"{value:.6g}")
+    header = [f"# {os.path.basename(args.config)} with the process model calibrated by",
+              "#   " + " ".join(sys.argv),
+              f"# (docs/method.md, \"Calibrating the process noise\"): training runs of seeds "
+              f"{args.seed}-{args.seed + args.runs - 1},",
+              "# the fit of the true motion, then the noise's factors set against the",
+              "# filters' mean pose NEES per dof (position, heading) on those runs:"]
+    header += [f"#   v x{sv:.4g}, w x{sw:.4g}: position {rp:.3f}, heading {rh:.3f}"
+               for sv, sw, rp, rh in history]
+    # Relative paths stay relative to the written file's folder.
+    base_dir = os.path.dirname(os.path.abspath(args.config))
+    out_dir = os.path.dirname(os.path.abspath(args.write))
+    for section, key in (("run", "world"), ("run", "robot_model")):
+        path = config.get(section, {}).get(key)
+        if isinstance(path, str) and not os.path.isabs(path):
+            config[section][key] = os.path.relpath(os.path.join(base_dir, path), out_dir)
+    with open(args.write, "w") as f:
+        f.write("\n".join(header) + "\n")
+        yaml.safe_dump(config, f, sort_keys=False, default_flow_style=False)
+
+
+def consistency(args):
+    """The whole procedure of --consistency (the module's docstring)."""
+    os.makedirs(args.consistency, exist_ok=True)
+    motion = os.path.join(args.consistency, "motion")
+    sweep(args, motion, [])
+    runs_steps, steps, c, k = read_runs([motion], args.offset)
+    lag = fit_lag(runs_steps)
+    apply_lag(runs_steps, lag)
+    command, gains = fit_command(runs_steps, 1, True)
+    values = ekf_values(gains, lag, command, fit_odometry(steps), c, k)
+    scale_v = scale_w = 1.0
+    history = []
+    for iteration in range(args.iterations):
+        values["command_noise"]["v_noise_scale"] = scale_v
+        values["command_noise"]["w_noise_scale"] = scale_w
+        out = os.path.join(args.consistency, f"scale_{iteration}")
+        sweep(args, out, set_overrides(values))
+        position, heading, count = pose_nees_per_dof([out])
+        history.append((scale_v, scale_w, position, heading))
+        print(f"# v x{scale_v:.4g}, w x{scale_w:.4g}: mean NEES per dof position "
+              f"{position:.3f}, heading {heading:.3f} ({count} filter steps)", flush=True)
+        if abs(position - 1.0) <= args.tolerance and abs(heading - 1.0) <= args.tolerance:
+            break
+        if iteration + 1 < args.iterations:
+            scale_v *= math.sqrt(position)
+            scale_w *= math.sqrt(heading)
+    best = min(history, key=lambda h: abs(math.log(h[2])) + abs(math.log(h[3])))
+    values["command_noise"]["v_noise_scale"] = best[0]
+    values["command_noise"]["w_noise_scale"] = best[1]
+    write_config(args, values, history)
+    print(f"# wrote {args.write}: v x{best[0]:.4g}, w x{best[1]:.4g}")
+    return 0
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("dirs", nargs="+", help="run or sweep directories")
+    parser.add_argument("dirs", nargs="*", help="run or sweep directories")
     parser.add_argument("--offset", type=float, default=0.2,
                         help="distance from the axle centre to R, metres (default 0.2)")
     parser.add_argument("--window", type=int, default=1,
@@ -389,15 +558,44 @@ def main():
     parser.add_argument("--no-lag", action="store_true",
                         help="no lag of the wheels behind the command (command_lag_s 0)")
     parser.add_argument("--json", help="also write the fitted values to this JSON file")
+    parser.add_argument("--consistency", metavar="WORK",
+                        help="run the training sweeps in WORK and scale the noise against the "
+                             "filters' NEES (the module's docstring); needs --write")
+    parser.add_argument("--write", metavar="CONFIG", help="--consistency: the config written")
+    parser.add_argument("--config", default="configs/default.yaml",
+                        help="--consistency: the base config (default configs/default.yaml)")
+    parser.add_argument("--mjslam", default="build/mjslam", help="--consistency: the binary")
+    parser.add_argument("--seed", type=int, default=101,
+                        help="--consistency: the training runs' first seed (default 101)")
+    parser.add_argument("--runs", type=int, default=25, help="--consistency: training runs")
+    parser.add_argument("--jobs", type=int, default=2, help="--consistency: runs at a time")
+    parser.add_argument("--iterations", type=int, default=6,
+                        help="--consistency: at most this many scaled sweeps (default 6)")
+    parser.add_argument("--tolerance", type=float, default=0.1,
+                        help="--consistency: stop when both means per dof are within this of 1")
     args = parser.parse_args()
+    if args.consistency is not None:
+        if not args.write or args.dirs:
+            print("calibrate_noise: --consistency needs --write CONFIG and no DIR",
+                  file=sys.stderr)
+            return 2
+        if args.runs < 1 or args.iterations < 1 or args.tolerance <= 0.0:
+            print(f"calibrate_noise: --runs, --iterations: expected >= 1, --tolerance > 0 "
+                  f"(got {args.runs}, {args.iterations}, {args.tolerance})", file=sys.stderr)
+            return 2
+        try:
+            return consistency(args)
+        except (OSError, ValueError) as e:
+            print(f"calibrate_noise: {e}", file=sys.stderr)
+            return 2
+    if not args.dirs:
+        print("calibrate_noise: expected a run or sweep directory (or --consistency)",
+              file=sys.stderr)
+        return 2
 
     try:
         runs = run_dirs(args.dirs)
-        runs_steps = [read_steps(run, args.offset) for run in runs]
-        steps = [s for run_steps in runs_steps for s in run_steps]
-        if len(steps) < 100:
-            raise ValueError(f"only {len(steps)} steps in {len(runs)} runs: too few to fit")
-        c, k = fit_skid(steps)
+        runs_steps, steps, c, k = read_runs(args.dirs, args.offset)
     except (OSError, ValueError) as e:
         print(f"calibrate_noise: {e}", file=sys.stderr)
         return 2
@@ -415,16 +613,11 @@ def main():
     print(f"    command_gain_v: {gains[0]:.6g}   # standard error {gains[2]:.2g}")
     print(f"    command_gain_w: {gains[1]:.6g}   # standard error {gains[3]:.2g}")
     print(f"    command_lag_s: {lag:.4g}")
-    names = ["v_noise_std_mps", "v_noise_fraction", "w_noise_std_radps", "w_noise_fraction",
-             "change_noise_fraction"]
     print("    command_noise:")
-    for name, value in zip(names, command):
+    for name, value in zip(COMMAND_NAMES, command):
         print(f"      {name}: {value:.4g}")
-    odometry_names = ["distance_noise_std_m", "distance_noise_std_m_per_sqrt_m",
-                      "heading_noise_std_rad", "heading_noise_std_rad_per_sqrt_m",
-                      "heading_noise_std_rad_per_sqrt_rad"]
     print("    odometry_noise:")
-    for name, value in zip(odometry_names, odometry):
+    for name, value in zip(ODOMETRY_NAMES, odometry):
         print(f"      {name}: {value:.4g}")
     print(f"    lateral_skid_s: {c:.4g}")
     print(f"    lateral_slip_std_m_per_rad: {k:.4g}")
@@ -473,10 +666,7 @@ def main():
 
     if args.json:
         values = {"steps": len(steps), "runs": len(runs),
-                  "command_gain_v": gains[0], "command_gain_w": gains[1], "command_lag_s": lag,
-                  "command_noise": dict(zip(names, command)),
-                  "odometry_noise": dict(zip(odometry_names, odometry)),
-                  "lateral_skid_s": c, "lateral_slip_std_m_per_rad": k}
+                  **ekf_values(gains, lag, command, odometry, c, k)}
         with open(args.json, "w") as f:
             json.dump(values, f, indent=2)
             f.write("\n")

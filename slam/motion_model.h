@@ -58,8 +58,8 @@ Twist2 FollowCommand(const Twist2& followed, const Twist2& command, double dt_s,
 /// null (FollowCommand) else `command`, with the gains `gain_v`, `gain_w`
 /// (EkfParams::command_gain_v, _w: the mean ratio of the robot's true speeds
 /// to its commands); covariance diag((dt sigma_v)^2, (dt sigma_w)^2) with
-///   sigma_v = v_noise_std_mps + v_noise_fraction |v|
-///             + change_noise_fraction |command.v - previous.v|   (likewise w),
+///   sigma_v = v_noise_scale (v_noise_std_mps + v_noise_fraction |v|
+///             + change_noise_fraction |command.v - previous.v|)   (likewise w),
 /// `previous` being the command of the record before (CommandNoiseParams).
 MotionInput CommandInput(const Twist2& command, double dt_s, const CommandNoiseParams& noise,
                          const Twist2& previous, double gain_v = 1.0, double gain_w = 1.0,

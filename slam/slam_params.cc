@@ -42,6 +42,8 @@ std::vector<ParamProblem> CommandNoiseParams::Validate() const {
   check.NonNegative("w_noise_std_radps", w_noise_std_radps);
   check.NonNegative("w_noise_fraction", w_noise_fraction);
   check.NonNegative("change_noise_fraction", change_noise_fraction);
+  check.Positive("v_noise_scale", v_noise_scale);
+  check.Positive("w_noise_scale", w_noise_scale);
   // A zero constant part would make a stopped robot's prediction exact.
   check.Require(v_noise_std_mps > 0.0 || w_noise_std_radps > 0.0, "v_noise_std_mps",
                 v_noise_std_mps, "a value > 0 when w_noise_std_radps is 0");

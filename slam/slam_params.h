@@ -69,9 +69,9 @@ SelectionPolicy SelectionPolicyFromName(const std::string& name);
 /// command`). The robot's real motion differs from the command through the
 /// wheel dynamics (lag, acceleration limits, slip), so these must cover that
 /// difference, not only actuator noise. One standard deviation each, held
-/// over the record's `dt_s`: sigma_v = v_noise_std_mps + v_noise_fraction |v|,
-/// sigma_w = w_noise_std_radps + w_noise_fraction |w|. Serialized under
-/// `slam.ekf.command_noise.*`.
+/// over the record's `dt_s`: sigma_v = v_noise_scale (v_noise_std_mps +
+/// v_noise_fraction |v| + change_noise_fraction |v - v_prev|), likewise
+/// sigma_w. Serialized under `slam.ekf.command_noise.*`.
 struct CommandNoiseParams {
   /// Constant part of the linear-velocity noise, m/s.
   double v_noise_std_mps = 0.03;
@@ -86,6 +86,13 @@ struct CommandNoiseParams {
   /// wheels follow a step in the command with a lag, so the motion over the
   /// period lies between the two commands.
   double change_noise_fraction = 0.5;
+  /// Factor on the whole of sigma_v (dimensionless, > 0): the fitted shape
+  /// above kept, its size set against the filters' consistency on training
+  /// runs (scripts/calibrate_noise.py --nees; docs/method.md, "Calibrating the
+  /// process noise"). 1: the terms above as they are.
+  double v_noise_scale = 1.0;
+  /// Factor on the whole of sigma_w; see `v_noise_scale`.
+  double w_noise_scale = 1.0;
 
   template <typename Archive>
   void Serialize(Archive* a) {
@@ -94,6 +101,8 @@ struct CommandNoiseParams {
     a->Visit(MJSLAM_NVP(w_noise_std_radps));
     a->Visit(MJSLAM_NVP(w_noise_fraction));
     a->Visit(MJSLAM_NVP(change_noise_fraction));
+    a->Visit(MJSLAM_NVP(v_noise_scale));
+    a->Visit(MJSLAM_NVP(w_noise_scale));
   }
   /// Every out-of-range field, keys relative to this struct.
   std::vector<ParamProblem> Validate() const;

@@ -4,6 +4,7 @@
 #include "slam/observation_models.h"
 
 #include <cmath>
+#include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -388,6 +389,29 @@ TEST(MotionModelTest, CommandInputScalesWithDt) {
   const MotionInput still = CommandInput(Twist2{0.5, -0.4}, 0.0, noise, Twist2{});
   EXPECT_EQ(still.increment.norm(), 0.0);
   EXPECT_EQ(still.covariance.norm(), 0.0);
+}
+
+// The factors multiply the whole of each standard deviation (constant,
+// speed and change terms), each of its own component only.
+TEST(MotionModelTest, CommandNoiseScalesMultiplyEachSigma) {
+  CommandNoiseParams noise;
+  noise.v_noise_std_mps = 0.02;
+  noise.v_noise_fraction = 0.1;
+  noise.w_noise_std_radps = 0.01;
+  noise.w_noise_fraction = 0.2;
+  noise.change_noise_fraction = 0.5;
+  noise.v_noise_scale = 0.5;
+  noise.w_noise_scale = 3.0;
+  const MotionInput input = CommandInput(Twist2{0.5, -0.4}, 0.2, noise, Twist2{0.3, 0.8});
+  EXPECT_NEAR(std::sqrt(input.covariance(0, 0)), 0.5 * 0.2 * (0.02 + 0.05 + 0.1), 1e-12);
+  EXPECT_NEAR(std::sqrt(input.covariance(1, 1)), 3.0 * 0.2 * (0.01 + 0.08 + 0.6), 1e-12);
+  EXPECT_NEAR(input.increment.x(), 0.1, 1e-12);
+  noise.v_noise_scale = 0.0;
+  noise.w_noise_scale = -1.0;
+  std::string keys;
+  for (const ParamProblem& problem : noise.Validate()) keys += problem.key + " ";
+  EXPECT_NE(keys.find("v_noise_scale"), std::string::npos) << keys;
+  EXPECT_NE(keys.find("w_noise_scale"), std::string::npos) << keys;
 }
 
 TEST(MotionModelTest, OdometryInputIsTheIncrementInThePreviousFrame) {
