@@ -23,6 +23,7 @@
 #include "app/replay.h"
 #include "app/run.h"
 #include "app/run_config.h"
+#include "app/run_pool.h"
 #include "app/slurm.h"
 #include "app/sweep.h"
 #include "app/version.h"
@@ -625,6 +626,7 @@ int main(int argc, char** argv) {
 
   std::signal(SIGINT, app::RequestStop);
   std::signal(SIGTERM, app::RequestStop);
+  app::StopWithParent(app::RequestStop);
   try {
     for (const auto& [command, execute] : commands) {
       if (command->parsed()) return execute();

@@ -3,11 +3,13 @@
 #include <fcntl.h>
 #include <signal.h>
 #include <spawn.h>
+#include <sys/prctl.h>
 #include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <chrono>
+#include <cstdlib>
 #include <cstring>
 #include <filesystem>
 #include <stdexcept>
@@ -27,7 +29,9 @@ namespace {
 namespace fs = std::filesystem;
 using rundir::PathIn;
 
-// Starts `argv` with stdout and stderr appended to `log_path`.
+// Starts `argv` with stdout and stderr appended to `log_path`, and
+// kStopWithParentVariable set to this process's id: the child stops (as on
+// SIGTERM) when the sweep dies, even by SIGKILL (StopWithParent).
 pid_t Spawn(const std::vector<std::string>& argv, const std::string& log_path) {
   posix_spawn_file_actions_t actions;
   posix_spawn_file_actions_init(&actions);
@@ -35,7 +39,7 @@ pid_t Spawn(const std::vector<std::string>& argv, const std::string& log_path) {
                                    O_WRONLY | O_CREAT | O_APPEND, 0644);
   posix_spawn_file_actions_adddup2(&actions, STDOUT_FILENO, STDERR_FILENO);
   try {
-    const pid_t pid = StartProcess(argv, actions, false);
+    const pid_t pid = StartProcess(argv, actions, false, true);
     posix_spawn_file_actions_destroy(&actions);
     return pid;
   } catch (...) {
@@ -70,18 +74,40 @@ double CpuSeconds(const struct rusage& usage) {
 }  // namespace
 
 pid_t StartProcess(const std::vector<std::string>& argv, const posix_spawn_file_actions_t& actions,
-                   bool search_path) {
+                   bool search_path, bool stop_with_parent) {
   std::vector<char*> args;
   for (const std::string& a : argv) args.push_back(const_cast<char*>(a.c_str()));
   args.push_back(nullptr);
+  // The environment: this process's, less any inherited parent link, plus
+  // the link to this process when asked.
+  const std::string prefix = std::string(kStopWithParentVariable) + "=";
+  const std::string link = prefix + std::to_string(::getpid());
+  std::vector<char*> env;
+  for (char** e = environ; *e != nullptr; ++e) {
+    if (std::strncmp(*e, prefix.c_str(), prefix.size()) != 0) env.push_back(*e);
+  }
+  if (stop_with_parent) env.push_back(const_cast<char*>(link.c_str()));
+  env.push_back(nullptr);
   pid_t pid = -1;
   const int error = search_path
-                        ? posix_spawnp(&pid, argv[0].c_str(), &actions, nullptr, args.data(), environ)
-                        : posix_spawn(&pid, argv[0].c_str(), &actions, nullptr, args.data(), environ);
+                        ? posix_spawnp(&pid, argv[0].c_str(), &actions, nullptr, args.data(), env.data())
+                        : posix_spawn(&pid, argv[0].c_str(), &actions, nullptr, args.data(), env.data());
   if (error != 0) {
     throw std::runtime_error("cannot start '" + argv[0] + "': " + std::strerror(error));
   }
   return pid;
+}
+
+void StopWithParent(void (*stop)(int)) {
+  const char* value = std::getenv(kStopWithParentVariable);
+  if (value == nullptr) return;
+  char* end = nullptr;
+  const long parent = std::strtol(value, &end, 10);
+  ::unsetenv(kStopWithParentVariable);  // not inherited by this process's children
+  if (end == value || *end != '\0' || parent <= 0) return;
+  ::prctl(PR_SET_PDEATHSIG, SIGTERM);
+  // The parent may have died before the line above: then stop now.
+  if (::getppid() != static_cast<pid_t>(parent)) stop(SIGTERM);
 }
 
 bool IsCompletedRun(const std::string& dir, bool* evaluated) {

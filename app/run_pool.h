@@ -58,11 +58,26 @@ struct RunPoolResult {
   double child_cpu_s = 0.0;
 };
 
+/// The environment variable through which a sweep tells the `mjslam`
+/// processes it starts its process id (StopWithParent).
+inline constexpr const char* kStopWithParentVariable = "MJSLAM_STOP_WITH_PARENT";
+
 /// Starts `argv` with `actions` applied in the child (argv[0] is a path, or a
-/// name looked up in PATH when `search_path`). Throws std::runtime_error
-/// naming argv[0] and the reason when it cannot be started.
+/// name looked up in PATH when `search_path`). With `stop_with_parent`, the
+/// child's environment names this process in kStopWithParentVariable (an
+/// `mjslam` child then stops when this process dies); an inherited value is
+/// never passed on. Throws std::runtime_error naming argv[0] and the reason
+/// when it cannot be started.
 pid_t StartProcess(const std::vector<std::string>& argv, const posix_spawn_file_actions_t& actions,
-                   bool search_path);
+                   bool search_path, bool stop_with_parent = false);
+
+/// Called by `main` at start: when the environment names a parent process
+/// (kStopWithParentVariable, set by a sweep's pool), asks the kernel to send
+/// this process SIGTERM when that parent dies, even by SIGKILL, and calls
+/// `stop(SIGTERM)` at once if it has already died. The run then ends as on
+/// Ctrl-C: whole rows, manifest `interrupted`, exit 130. The variable is
+/// removed, so this process's own children do not inherit it.
+void StopWithParent(void (*stop)(int));
 
 /// True when `dir` holds a completed run (manifest status "completed" and a
 /// readable summary.json); `*evaluated` tells whether its summary has the

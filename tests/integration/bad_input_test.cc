@@ -279,5 +279,54 @@ TEST_F(BadInputTest, SweepResumeRefusesToWriteWhereALiveRunWrites) {
   ::waitpid(holder, nullptr, 0);
 }
 
+// A sweep killed with SIGKILL takes its runs with it: each child was linked
+// to it (MJSLAM_STOP_WITH_PARENT, app::StopWithParent) and ends as on
+// Ctrl-C, with whole rows and its manifest saying `interrupted`. Before, the
+// children ran on, and a resume started the same seeds beside them.
+TEST_F(BadInputTest, SweepKilledHardStopsItsRuns) {
+  const std::string sweep = fs::path(base_).parent_path() / "killed_sweep";
+  fs::remove_all(sweep);
+  const std::string log = fs::path(base_).parent_path() / "killed_sweep.log";
+  // Room tours of 3000 s: several seconds of CPU each, so both runs are alive
+  // when the sweep is killed.
+  const std::string command = "exec " + Program() + " sweep --runs 2 --jobs 2 --quiet --out " + sweep +
+                              " --set run.world=" + std::string(MJSLAM_SOURCE_DIR) +
+                              "/worlds/room.xml --set control.driver=tour --set run.duration_s=3000"
+                              " --set render.enabled=false > " + log + " 2>&1";
+  const pid_t parent = ::fork();
+  ASSERT_GE(parent, 0);
+  if (parent == 0) {
+    ::execl("/bin/sh", "sh", "-c", command.c_str(), static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  // Wait until both runs have written rows, then kill the sweep outright.
+  const std::vector<std::string> runs = {sweep + "/runs/run_000", sweep + "/runs/run_001"};
+  auto rows_written = [&] {
+    for (const std::string& run : runs) {
+      if (!fs::exists(run + "/trajectory.csv") || fs::file_size(run + "/trajectory.csv") < 20000) return false;
+    }
+    return true;
+  };
+  for (int i = 0; i < 600 && !rows_written(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  ASSERT_TRUE(rows_written()) << ReadText(log);
+  ASSERT_EQ(::kill(parent, SIGKILL), 0);
+  ::waitpid(parent, nullptr, 0);
+  // Each run ends within seconds (it would take far longer to finish), and
+  // says it was interrupted.
+  auto stopped = [&] {
+    for (const std::string& run : runs) {
+      const nlohmann::json manifest = nlohmann::json::parse(ReadText(run + "/manifest.json"), nullptr, false);
+      if (manifest.is_discarded() || manifest.value("status", "") == "running") return false;
+    }
+    return true;
+  };
+  for (int i = 0; i < 300 && !stopped(); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  ASSERT_TRUE(stopped());
+  for (const std::string& run : runs) {
+    const nlohmann::json manifest = nlohmann::json::parse(ReadText(run + "/manifest.json"));
+    EXPECT_EQ(manifest.value("status", ""), "interrupted") << run;
+  }
+}
+
 }  // namespace
 }  // namespace mjslam::testing

@@ -1,9 +1,13 @@
 // The maze map loss through the real program (docs/results.md, "The maze
-// map loss"): 480 s of seed 1 in tests/tools/maze_40x40.xml. With the
+// map loss"): 540 s of seed 1 in tests/tools/maze_40x40.xml. With the
 // paper's rule of new features (slam.ekf.new_features_need_match false)
-// both filters add a scan of copies at t = 472.0 s, where their map is
-// first copied, and summary.json reports it; with the default rule the same
-// 480 s are quiet. Label `slow` (two runs, about 15 CPU-s each).
+// both filters add a scan of copies at t = 532.0 s, where their map is
+// first copied (in the whole 1400 s run their position error goes from
+// 7 mm before it to 0.1 m after it, mean NEES 742 and 2332), and
+// summary.json reports it; with the default rule the same 540 s are quiet.
+// The time depends on the explorer's path: a change of the explorer moves
+// it (it was 472.0 s before the explorer's door rules). Label `slow` (two
+// runs, about 5 CPU-s each).
 #include <optional>
 #include <string>
 
@@ -20,12 +24,12 @@ using testing::Program;
 using testing::ReadText;
 using testing::Shell;
 
-// Runs the maze for 480 s (seed 1) with `extra` arguments; returns summary.json.
+// Runs the maze for 540 s (seed 1) with `extra` arguments; returns summary.json.
 nlohmann::json MazeRun(const std::string& name, const std::string& extra) {
   const std::string dir = FreshDir(name);
   const std::string world = std::string(MJSLAM_SOURCE_DIR) + "/tests/tools/maze_40x40.xml";
   const int status = Shell(Program() + " run --quiet --no-render --no-evaluate --world " + world +
-                           " --duration 480 --seed 1 --out " + dir + "/run " + extra + " > " +
+                           " --duration 540 --seed 1 --out " + dir + "/run " + extra + " > " +
                            dir + "/log 2>&1");
   EXPECT_EQ(status, 0) << ReadText(dir + "/log");
   return nlohmann::json::parse(ReadText(dir + "/run/summary.json"));
@@ -37,7 +41,7 @@ TEST(MapLossRunTest, CopyTestReportsTheMazeMapLossAndIsQuietWithTheRule) {
   for (const char* f : {"classical", "selective"}) {
     const nlohmann::json& check = lost["filters"][f]["innovation_check"];
     ASSERT_FALSE(check["map_copied_at_s"].is_null()) << f << " " << check.dump();
-    EXPECT_NEAR(check["map_copied_at_s"].get<double>(), 472.0, 0.05) << f;
+    EXPECT_NEAR(check["map_copied_at_s"].get<double>(), 532.0, 0.05) << f;
     EXPECT_GE(check["copied_scans"].get<int>(), 1) << f;
     EXPECT_EQ(check["verdict"], "inconsistent") << f;
   }
