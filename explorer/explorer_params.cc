@@ -26,8 +26,11 @@ std::vector<ParamProblem> ExplorerParams::Validate() const {
                 preferred_clearance_m, "a value >= clearance_m");
   check.NonNegative("clearance_cost_weight", clearance_cost_weight);
   check.NonNegative("narrow_cost_weight", narrow_cost_weight);
-  check.Require(turn_clearance_m >= clearance_m, "turn_clearance_m", turn_clearance_m,
-                "a value >= clearance_m");
+  // Below clearance_m it is simply met wherever a path may go (every cell a
+  // plan uses has clearance_m), so a config with a large clearance_m (such
+  // as the 0.5 m of run directories made before this key existed) stays
+  // valid.
+  check.Positive("turn_clearance_m", turn_clearance_m);
   check.NonNegative("escape_radius_m", escape_radius_m);
   check.Positive("min_turn_radius_m", min_turn_radius_m);
   check.Require(max_turn_radius_m >= min_turn_radius_m, "max_turn_radius_m",

@@ -190,5 +190,17 @@ TEST(ExplorerParamsTest, DefaultsAreValidAndBadValuesAreNamed) {
   EXPECT_THROW(Explorer(ExplorerParams{}, 0.0), ParamError);
 }
 
+// A clearance above the turning room is a valid config (the turning room is
+// then met wherever a path may go): run directories made with the former
+// default clearance_m 0.5 load and evaluate. A turning room of 0 does not.
+TEST(ExplorerParamsTest, TurningRoomBelowTheClearanceIsValid) {
+  ExplorerParams params;
+  params.clearance_m = 0.5;
+  params.preferred_clearance_m = 0.9;
+  EXPECT_TRUE(params.Validate().empty());
+  params.turn_clearance_m = 0.0;
+  EXPECT_FALSE(params.Validate().empty());
+}
+
 }  // namespace
 }  // namespace mjslam::explorer
