@@ -174,8 +174,14 @@ def plot_nees(nees, path, where=""):
     # Plain numbers on the log axis (not 4x10^0).
     plain = matplotlib.ticker.FuncFormatter(lambda value, _: f"{value:g}")
     ax.yaxis.set_major_formatter(plain)
-    ax.yaxis.set_minor_formatter(plain)
-    ax.tick_params(axis="y", which="minor", labelsize=7)
+    # Minor ticks labelled only where the axis spans about a decade; over several decades their
+    # labels would overlap.
+    low, high = ax.get_ylim()
+    if high <= 20.0 * low:
+        ax.yaxis.set_minor_formatter(plain)
+        ax.tick_params(axis="y", which="minor", labelsize=7)
+    else:
+        ax.yaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
     ax.set_title(f"Average NEES over {int(max(n_runs)) if n_runs else 0} runs{where}\n"
                  "(a consistency test, not a figure of the paper)")
     ax.grid(True, alpha=0.3, which="both")

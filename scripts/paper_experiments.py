@@ -423,12 +423,12 @@ def draw_model_figures(res, fig_dir, points_margin_m=0.5):
                            % where)
     nees = figs.read_csv(os.path.join(res["dir"], "corridor", "nees.csv"))
     # nees.csv (mjslam sweep) averages every step; under realtime a skipped step holds the
-    # estimate of an earlier pose (figs.processed_steps), so say so in the title.
+    # estimate of its last processed step, compared with that step's truth, so say so.
     stale = any(r[f]["processed"]["steps"] < r[f]["steps"] for r in res["corridor_runs"]
                 for f in FILTERS)
     figs.plot_nees(nees, os.path.join(fig_dir, "anees_corridor_%s.png" % model),
-                   ", %s, corridor loop%s" % (label, ",\nevery step (realtime: skipped steps "
-                                              "compare an earlier estimate)" if stale else ""))
+                   ", %s, corridor loop%s" % (label, ",\nevery step (realtime: a skipped step "
+                                              "counts the estimate it holds)" if stale else ""))
 
 
 # ---------------------------------------------------------------------------------------------
