@@ -414,6 +414,33 @@ TEST(MotionModelTest, CommandNoiseScalesMultiplyEachSigma) {
   EXPECT_NE(keys.find("w_noise_scale"), std::string::npos) << keys;
 }
 
+// The settle term widens each sigma by its fraction of the command's change
+// one record earlier (the wheels still settling), of its own component only,
+// and the factors multiply it too.
+TEST(MotionModelTest, SettleNoiseFollowsThePreviousChange) {
+  CommandNoiseParams noise;
+  noise.v_noise_std_mps = 0.02;
+  noise.v_noise_fraction = 0.1;
+  noise.w_noise_std_radps = 0.01;
+  noise.w_noise_fraction = 0.2;
+  noise.change_noise_fraction = 0.5;
+  noise.settle_noise_fraction = 0.25;
+  const Twist2 command{0.5, -0.4};
+  const MotionInput held = CommandInput(command, 0.2, noise, command);
+  EXPECT_NEAR(std::sqrt(held.covariance(0, 0)), 0.2 * (0.02 + 0.05), 1e-12);
+  const MotionInput settling =
+      CommandInput(command, 0.2, noise, command, 1.0, 1.0, nullptr, Twist2{0.2, -1.2});
+  EXPECT_NEAR(std::sqrt(settling.covariance(0, 0)), 0.2 * (0.02 + 0.05 + 0.05), 1e-12);
+  EXPECT_NEAR(std::sqrt(settling.covariance(1, 1)), 0.2 * (0.01 + 0.08 + 0.3), 1e-12);
+  noise.w_noise_scale = 2.0;
+  const MotionInput scaled =
+      CommandInput(command, 0.2, noise, command, 1.0, 1.0, nullptr, Twist2{0.2, -1.2});
+  EXPECT_NEAR(std::sqrt(scaled.covariance(1, 1)), 2.0 * 0.2 * (0.01 + 0.08 + 0.3), 1e-12);
+  noise.settle_noise_fraction = -0.1;
+  ASSERT_EQ(noise.Validate().size(), 1u);
+  EXPECT_EQ(noise.Validate()[0].key, "settle_noise_fraction");
+}
+
 TEST(MotionModelTest, OdometryInputIsTheIncrementInThePreviousFrame) {
   OdometryNoiseParams noise;
   // From (1, 1, pi/2), an arc of 0.3 m turning by 0.2 (a = 0.2): the input
