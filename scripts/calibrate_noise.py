@@ -118,12 +118,15 @@ def axle_increment(x0, y0, th0, x1, y1, th1, offset):
 
 
 def read_steps(run, offset):
-    """One dict per step of the run's trajectory.csv (from its third row)."""
+    """One dict per step of the run's trajectory.csv, from its first row: the
+    robot at rest before it (the command before the first zero), as the
+    filters start (slam::EkfSlam's previous command and followed speeds)."""
     path = os.path.join(run, "trajectory.csv")
     with open(path) as f:
         rows = list(csv.DictReader(f))
     steps = []
-    for line, (r0, r1, r2) in enumerate(zip(rows, rows[1:], rows[2:]), start=3):
+    rest = {"cmd_v": "0", "cmd_w": "0"}
+    for line, (r0, r1, r2) in enumerate(zip([rest] + rows, rows, rows[1:]), start=2):
         try:
             t1, t2 = float(r1["t"]), float(r2["t"])
             true0 = [float(r1[k]) for k in ("true_x", "true_y", "true_th")]
