@@ -48,11 +48,7 @@ an arc along the mid-arc heading, plus a sideways skid):
   the distance rolled and the angle turned), fitted by maximum likelihood.
 - skid: the sideways motion of the axle, -c v w dt, c by least squares
   (as scripts/measure_skid.py); what is left, per radian turned, is
-  lateral_slip_std_m_per_rad (root of sum(r^2) / sum(dth^2)) over the steps
-  turning on the spot (true speed below ON_SPOT_MPS), and
-  lateral_slip_std_m_per_rad_per_mps over the others, so that sum(r^2) =
-  sum(dth^2 (k^2 + (k_v v)^2)) there (v = |d| / dt); with no turn on the
-  spot, k over all steps and k_v = 0.
+  lateral_slip_std_m_per_rad (root of sum(r^2) / sum(dth^2)).
 
 Prints the fitted values as the YAML of configs/default.yaml's slam.ekf
 section, and for each fit the mean of (error / sigma)^2 (1 for a model that
@@ -386,31 +382,18 @@ def fit_odometry(steps):
     return fit(nll, [1e-4, 1e-3, 1e-4, 1e-3, 1e-3])
 
 
-ON_SPOT_MPS = 0.01  # below this true speed a step turns on the spot (the slip's fit)
-
-
 def fit_skid(steps):
-    """(c, (k, k_v)): the skid constant by least squares and the slip per
-    radian turned that is left, on the spot (k) and its growth with the
-    speed (k_v; the module's docstring)."""
+    """(c, k): the skid constant by least squares and the slip per radian
+    turned that is left."""
     xs = [-s["d"] * s["dth"] / s["dt"] for s in steps]
     ys = [s["lateral"] for s in steps]
     sxx = sum(x * x for x in xs)
     if sxx == 0.0:
         raise ValueError("no turns while moving: the skid is undetermined")
     c = sum(x * y for x, y in zip(xs, ys)) / sxx
-    residual2 = [(y - c * x) ** 2 for x, y in zip(xs, ys)]
-    speed = [abs(s["d"]) / s["dt"] for s in steps]
-    spot = [i for i, v in enumerate(speed) if v < ON_SPOT_MPS]
-    moving = [i for i, v in enumerate(speed) if v >= ON_SPOT_MPS]
-    spot_turned2 = sum(steps[i]["dth"] ** 2 for i in spot)
-    if spot_turned2 == 0.0:
-        return c, (math.sqrt(sum(residual2) / sum(s["dth"] ** 2 for s in steps)), 0.0)
-    k2 = sum(residual2[i] for i in spot) / spot_turned2
-    left = sum(residual2[i] - k2 * steps[i]["dth"] ** 2 for i in moving)
-    moving_turned2 = sum((steps[i]["dth"] * speed[i]) ** 2 for i in moving)
-    k_v = math.sqrt(max(left, 0.0) / moving_turned2) if moving_turned2 > 0.0 else 0.0
-    return c, (math.sqrt(k2), k_v)
+    residual2 = sum((y - c * x) ** 2 for x, y in zip(xs, ys))
+    turned2 = sum(s["dth"] ** 2 for s in steps)
+    return c, math.sqrt(residual2 / turned2)
 
 
 def print_bins(title, steps, key, edges, normalised):
@@ -426,7 +409,7 @@ def print_bins(title, steps, key, edges, normalised):
 
 
 def read_runs(dirs, offset):
-    """(runs_steps, steps, skid c, slip (k, k_v)) of the runs in `dirs`; raises
+    """(runs_steps, steps, skid c, slip k) of the runs in `dirs`; raises
     OSError or ValueError naming the file."""
     runs = run_dirs(dirs)
     runs_steps = [read_steps(run, offset) for run in runs]
@@ -449,8 +432,7 @@ def ekf_values(gains, lag, command, odometry, c, k):
     return {"command_gain_v": gains[0], "command_gain_w": gains[1], "command_lag_s": lag,
             "command_noise": dict(zip(COMMAND_NAMES, command)),
             "odometry_noise": dict(zip(ODOMETRY_NAMES, odometry)),
-            "lateral_skid_s": c, "lateral_slip_std_m_per_rad": k[0],
-            "lateral_slip_std_m_per_rad_per_mps": k[1]}
+            "lateral_skid_s": c, "lateral_slip_std_m_per_rad": k}
 
 
 def set_overrides(values, prefix="slam.ekf"):
@@ -650,8 +632,7 @@ def main():
     for name, value in zip(ODOMETRY_NAMES, odometry):
         print(f"      {name}: {value:.4g}")
     print(f"    lateral_skid_s: {c:.4g}")
-    print(f"    lateral_slip_std_m_per_rad: {k[0]:.4g}")
-    print(f"    lateral_slip_std_m_per_rad_per_mps: {k[1]:.4g}")
+    print(f"    lateral_slip_std_m_per_rad: {k:.4g}")
 
     print(f"# command noise fitted to errors summed over {args.window} step(s)")
     print("# summed errors over windows of L steps: mean e^2 / model variance, distance and turn")
