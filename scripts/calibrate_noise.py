@@ -24,12 +24,14 @@ an arc along the mid-arc heading, plus a sideways skid):
   the gains by least squares at each tau; --no-lag keeps tau 0) and scaled
   by the gains g_v and g_w (slam.ekf.command_gain_v, _w: the
   robot's mean speed over its command), its noise growing with the change
-  from the command of row k-2. The errors e_v = d / dt - g_v v_f and
+  from the command of row k-2 and with the change one row earlier (row k-2
+  from row k-3: the wheels still settling). The errors e_v = d / dt - g_v v_f and
   e_w = dth / dt - g_w w_f (v_f, w_f the speeds followed) of the true increment (d, dth) are modelled as
   independent zero-mean Gaussians with
       sigma_v = v_noise_std_mps + v_noise_fraction |v_f| + change_noise_fraction |v - v_prev|
-      sigma_w = w_noise_std_radps + w_noise_fraction |w_f| + change_noise_fraction |w - w_prev|
-  (slam/motion_model.h, CommandInput); the five constants and the two gains
+                + settle_noise_fraction |v_prev - v_prev2|
+      sigma_w = likewise with w_noise_std_radps, w_noise_fraction
+  (slam/motion_model.h, CommandInput); the six constants and the two gains
   are fitted by maximum likelihood (alternately: the gains by weighted least
   squares with the sigmas fixed, the sigmas by Nelder-Mead with the gains
   fixed). --no-gain keeps the gains at 1 (the paper's model). The gains of
@@ -116,12 +118,15 @@ def axle_increment(x0, y0, th0, x1, y1, th1, offset):
 
 
 def read_steps(run, offset):
-    """One dict per step of the run's trajectory.csv (from its third row)."""
+    """One dict per step of the run's trajectory.csv, from its first row: the
+    robot at rest before it (the command before the first zero), as the
+    filters start (slam::EkfSlam's previous command and followed speeds)."""
     path = os.path.join(run, "trajectory.csv")
     with open(path) as f:
         rows = list(csv.DictReader(f))
     steps = []
-    for line, (r0, r1, r2) in enumerate(zip(rows, rows[1:], rows[2:]), start=3):
+    rest = {"cmd_v": "0", "cmd_w": "0"}
+    for line, (r0, r1, r2) in enumerate(zip([rest] + rows, rows, rows[1:]), start=2):
         try:
             t1, t2 = float(r1["t"]), float(r2["t"])
             true0 = [float(r1[k]) for k in ("true_x", "true_y", "true_th")]
@@ -140,6 +145,10 @@ def read_steps(run, offset):
         steps.append({"dt": dt, "v": v, "w": w, "dv": abs(v - v_prev), "dw": abs(w - w_prev),
                       "d": d, "dth": dth, "lateral": lateral,
                       "d_odom": d_odom, "dth_odom": dth_odom})
+    # The change of the command one row earlier (zero at the first step).
+    for before, s in zip([None] + steps, steps):
+        s["dv1"] = before["dv"] if before else 0.0
+        s["dw1"] = before["dw"] if before else 0.0
     return steps
 
 
@@ -203,9 +212,12 @@ def gaussian_nll(errors_and_variances):
 
 
 def command_sigmas(s, p):
-    """(sigma_v, sigma_w) of CommandInput for step s, p = (v0, kv, w0, kw, kc)."""
+    """(sigma_v, sigma_w) of CommandInput for step s, p = (v0, kv, w0, kw, kc,
+    ks): ks the settle term's fraction (0 when p has five values)."""
     v0, kv, w0, kw, kc = p[:5]
-    return (v0 + kv * abs(s["fv"]) + kc * s["dv"], w0 + kw * abs(s["fw"]) + kc * s["dw"])
+    ks = p[5] if len(p) > 5 else 0.0
+    return (v0 + kv * abs(s["fv"]) + kc * s["dv"] + ks * s["dv1"],
+            w0 + kw * abs(s["fw"]) + kc * s["dw"] + ks * s["dw1"])
 
 
 def command_errors(s, gains=(1.0, 1.0)):
@@ -326,7 +338,7 @@ def fit_command(runs_steps, window, with_gains=True, rounds=3):
     windows = windows_of(runs_steps, window)
     steps = [s for run_steps in runs_steps for s in run_steps]
     gains = (1.0, 1.0, 0.0, 0.0)
-    p = [0.01, 0.05, 0.01, 0.05, 0.3]
+    p = [0.01, 0.05, 0.01, 0.05, 0.3, 0.1]
     for _ in range(rounds if with_gains else 1):
         p = fit(lambda q: gaussian_nll(window_pairs(windows, q, gains[:2])), p)
         if with_gains:
@@ -409,7 +421,7 @@ def read_runs(dirs, offset):
 
 
 COMMAND_NAMES = ["v_noise_std_mps", "v_noise_fraction", "w_noise_std_radps", "w_noise_fraction",
-                 "change_noise_fraction"]
+                 "change_noise_fraction", "settle_noise_fraction"]
 ODOMETRY_NAMES = ["distance_noise_std_m", "distance_noise_std_m_per_sqrt_m",
                   "heading_noise_std_rad", "heading_noise_std_rad_per_sqrt_m",
                   "heading_noise_std_rad_per_sqrt_rad"]

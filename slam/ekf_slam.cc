@@ -220,7 +220,8 @@ MotionInput EkfSlam::CheckedMotionInput(const SensorRecord& record) const {
     const Twist2 followed =
         FollowCommand(followed_command_, record.command, record.dt_s, params_.command_lag_s);
     input = CommandInput(record.command, record.dt_s, params_.command_noise, previous_command_,
-                         params_.command_gain_v, params_.command_gain_w, &followed);
+                         params_.command_gain_v, params_.command_gain_w, &followed,
+                         previous_change_);
   }
   const double slip_std = params_.lateral_slip_std_m_per_rad * std::abs(input.increment.y());
   input.lateral_variance_m2 = slip_std * slip_std;
@@ -236,6 +237,8 @@ void EkfSlam::Predict(const SensorRecord& record, const MotionInput& input) {
   }
   followed_command_ =
       FollowCommand(followed_command_, record.command, record.dt_s, params_.command_lag_s);
+  previous_change_ = Twist2{record.command.v_mps - previous_command_.v_mps,
+                            record.command.w_radps - previous_command_.w_radps};
   previous_command_ = record.command;
   state_.Predict(input, params_.control_point_offset_m);
 }

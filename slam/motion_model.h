@@ -59,11 +59,14 @@ Twist2 FollowCommand(const Twist2& followed, const Twist2& command, double dt_s,
 /// (EkfParams::command_gain_v, _w: the mean ratio of the robot's true speeds
 /// to its commands); covariance diag((dt sigma_v)^2, (dt sigma_w)^2) with
 ///   sigma_v = v_noise_scale (v_noise_std_mps + v_noise_fraction |v|
-///             + change_noise_fraction |command.v - previous.v|)   (likewise w),
-/// `previous` being the command of the record before (CommandNoiseParams).
+///             + change_noise_fraction |command.v - previous.v|
+///             + settle_noise_fraction |previous_change.v|)   (likewise w),
+/// `previous` being the command of the record before and `previous_change`
+/// the change of the command at that record (its command less the one
+/// before it; zero at the first records) (CommandNoiseParams).
 MotionInput CommandInput(const Twist2& command, double dt_s, const CommandNoiseParams& noise,
                          const Twist2& previous, double gain_v = 1.0, double gain_w = 1.0,
-                         const Twist2* followed = nullptr);
+                         const Twist2* followed = nullptr, const Twist2& previous_change = {});
 
 /// The wheel-odometry increment between two records as the equivalent input:
 /// the (d, dth) that PredictPose with offset `a_m` turns into the motion

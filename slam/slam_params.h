@@ -86,6 +86,12 @@ struct CommandNoiseParams {
   /// wheels follow a step in the command with a lag, so the motion over the
   /// period lies between the two commands.
   double change_noise_fraction = 0.5;
+  /// Part of the noise proportional to the change of the command one record
+  /// earlier (|v_prev - v_prev2|, likewise w; dimensionless): the simulated
+  /// wheels are still settling in the period after a step of the command,
+  /// which the first-order lag (EkfParams::command_lag_s) does not follow
+  /// (docs/method.md, departure 22). 0: no such term.
+  double settle_noise_fraction = 0.0;
   /// Factor on the whole of sigma_v (dimensionless, > 0): the fitted shape
   /// above kept, its size set against the filters' consistency on training
   /// runs (scripts/calibrate_noise.py --nees; docs/method.md, "Calibrating the
@@ -101,6 +107,7 @@ struct CommandNoiseParams {
     a->Visit(MJSLAM_NVP(w_noise_std_radps));
     a->Visit(MJSLAM_NVP(w_noise_fraction));
     a->Visit(MJSLAM_NVP(change_noise_fraction));
+    a->Visit(MJSLAM_NVP(settle_noise_fraction));
     a->Visit(MJSLAM_NVP(v_noise_scale));
     a->Visit(MJSLAM_NVP(w_noise_scale));
   }

@@ -1,15 +1,18 @@
 #!/usr/bin/python3
-"""Test of scripts/calibrate_noise.py's command-following fit: it must recover the gains and
-the lag of a robot made with known ones.
+"""Test of scripts/calibrate_noise.py's command-following fit: it must recover the gains, the
+lag and the settling wheels' noise of a robot made with known ones.
 
     /usr/bin/python3 tests/integration/calibrate_noise_test.py SOURCE_DIR
 
 Three synthetic runs (seeds 1-3, 600 steps of 0.1 s each) of a unicycle whose axle centre moves
 at the commands through a first-order lag of tau = 0.05 s, times the gains 0.99 (speed) and 1.01
-(turn rate), plus white noise of 1 mm/s and 5 mrad/s; the point R 0.2 m ahead of the axle, as the
-script assumes. Asserted: the fitted command_lag_s within 0.005 s of 0.05, command_gain_v within
-0.002 of 0.99, command_gain_w within 0.005 of 1.01. Shown by hand to fail: with the script's lag
-left at 0 (--no-lag) the gains are still found but the test fails on the lag.
+(turn rate), plus white noise of 1 mm/s and 5 mrad/s and, in the period after each change of the
+command, 0.1 of that change (the settling wheels, slam.ekf.command_noise.settle_noise_fraction);
+the robot at rest before the first row; the point R 0.2 m ahead of the axle, as the script
+assumes. Asserted: the fitted command_lag_s within 0.005 s of 0.05, command_gain_v within 0.002
+of 0.99, command_gain_w within 0.005 of 1.01, settle_noise_fraction within 0.02 of 0.1. Shown by
+hand to fail: with the script's lag left at 0 (--no-lag) the gains are still found but the test
+fails on the lag; with the settle term left out of the script's sigmas it fails on it.
 
 Exit status 0 when the values are recovered, 1 with the reasons otherwise.
 """
@@ -26,6 +29,7 @@ import tempfile
 TAU = 0.05
 GAIN_V = 0.99
 GAIN_W = 1.01
+SETTLE = 0.1
 OFFSET = 0.2
 DT = 0.1
 
@@ -37,6 +41,8 @@ def write_run(directory, seed):
     x = y = th = 0.0
     fv = fw = 0.0
     v = w = 0.0
+    previous = [0.0, 0.0]  # the command of the row before (at rest before the first)
+    settle = [0.0, 0.0]    # |change| of the command at the row before
     beta = 1.0 - math.exp(-DT / TAU)
     with open(os.path.join(directory, "trajectory.csv"), "w", newline="") as f:
         writer = csv.writer(f)
@@ -52,8 +58,10 @@ def write_run(directory, seed):
             writer.writerow([f"{k * DT:.3f}", rx, ry, th, *odometry, v, w])
             fv += beta * (v - fv)
             fw += beta * (w - fw)
-            d = (GAIN_V * fv + rng.gauss(0, 0.001)) * DT
-            dth = (GAIN_W * fw + rng.gauss(0, 0.005)) * DT
+            d = (GAIN_V * fv + rng.gauss(0, 0.001 + SETTLE * settle[0])) * DT
+            dth = (GAIN_W * fw + rng.gauss(0, 0.005 + SETTLE * settle[1])) * DT
+            settle = [abs(v - previous[0]), abs(w - previous[1])]
+            previous = [v, w]
             half = 0.5 * dth
             chord = d * (math.sin(half) / half if abs(half) > 1e-9 else 1.0)
             x += chord * math.cos(th + half)
@@ -80,13 +88,16 @@ def main(source_dir):
             values = json.load(f)
         print(f"fitted: command_lag_s {values['command_lag_s']:.4f} (made {TAU}), command_gain_v "
               f"{values['command_gain_v']:.4f} ({GAIN_V}), command_gain_w "
-              f"{values['command_gain_w']:.4f} ({GAIN_W})")
+              f"{values['command_gain_w']:.4f} ({GAIN_W}), settle_noise_fraction "
+              f"{values['command_noise']['settle_noise_fraction']:.4f} ({SETTLE})")
         problems = []
         for key, made, tolerance in (("command_lag_s", TAU, 0.005),
                                      ("command_gain_v", GAIN_V, 0.002),
-                                     ("command_gain_w", GAIN_W, 0.005)):
-            if abs(values[key] - made) > tolerance:
-                problems.append(f"{key}: fitted {values[key]:.5f}, made {made} (tolerance "
+                                     ("command_gain_w", GAIN_W, 0.005),
+                                     ("settle_noise_fraction", SETTLE, 0.02)):
+            fitted_value = values.get(key, values["command_noise"].get(key))
+            if abs(fitted_value - made) > tolerance:
+                problems.append(f"{key}: fitted {fitted_value:.5f}, made {made} (tolerance "
                                 f"{tolerance})")
         for problem in problems:
             print(problem)

@@ -209,6 +209,28 @@ TEST(EkfSlamTest, PredictsFromCommands) {
   EXPECT_GT(filter.pose_covariance()(0, 0), 0.0);
 }
 
+// The settle term (command_noise.settle_noise_fraction) widens the step
+// after a change of the command by its fraction of that change, and no other:
+// the command steps from rest to 0.5 m/s at the first record and is then held.
+TEST(EkfSlamTest, SettleNoiseWidensTheStepAfterAChange) {
+  EkfParams params;
+  params.control_point_offset_m = 0.2;
+  params.command_noise.settle_noise_fraction = 0.3;
+  EkfSlam filter(params, CorrectionMode::kClassical, Pose2(1.0, 2.0, kPi / 2.0), Pose2());
+  SensorRecord record;
+  record.dt_s = 0.1;
+  record.command = Twist2{0.5, 0.0};
+  for (int i = 0; i < 10; ++i) filter.Step(record, nullptr);
+  const double sigma_v = params.command_noise.v_noise_std_mps +
+                         params.command_noise.v_noise_fraction * 0.5;
+  const double sigma_first = sigma_v + params.command_noise.change_noise_fraction * 0.5;
+  const double sigma_second = sigma_v + 0.3 * 0.5;
+  EXPECT_NEAR(filter.pose_covariance()(1, 1),
+              0.01 * (sigma_first * sigma_first + sigma_second * sigma_second +
+                      8 * sigma_v * sigma_v),
+              1e-12);
+}
+
 TEST(EkfSlamTest, PredictsFromOdometry) {
   // Odometry generated with Eq. (6)'s own kinematics, (d, a dth, dth) per
   // record in the previous R frame: without skid, the filter must reproduce

@@ -367,13 +367,20 @@ TEST(MotionModelTest, JacobiansAAndWMatchCentralDifferences) {
   }
 }
 
-TEST(MotionModelTest, CommandInputScalesWithDt) {
+// The command noise of the CommandInput tests: 0.02 m/s + 10 %, 0.01 rad/s +
+// 20 %, half the command's change.
+CommandNoiseParams TestCommandNoise() {
   CommandNoiseParams noise;
   noise.v_noise_std_mps = 0.02;
   noise.v_noise_fraction = 0.1;
   noise.w_noise_std_radps = 0.01;
   noise.w_noise_fraction = 0.2;
   noise.change_noise_fraction = 0.5;
+  return noise;
+}
+
+TEST(MotionModelTest, CommandInputScalesWithDt) {
+  CommandNoiseParams noise = TestCommandNoise();
   const MotionInput input = CommandInput(Twist2{0.5, -0.4}, 0.2, noise, Twist2{0.5, -0.4});
   EXPECT_NEAR(input.increment.x(), 0.1, 1e-12);
   EXPECT_NEAR(input.increment.y(), -0.08, 1e-12);
@@ -394,12 +401,7 @@ TEST(MotionModelTest, CommandInputScalesWithDt) {
 // The factors multiply the whole of each standard deviation (constant,
 // speed and change terms), each of its own component only.
 TEST(MotionModelTest, CommandNoiseScalesMultiplyEachSigma) {
-  CommandNoiseParams noise;
-  noise.v_noise_std_mps = 0.02;
-  noise.v_noise_fraction = 0.1;
-  noise.w_noise_std_radps = 0.01;
-  noise.w_noise_fraction = 0.2;
-  noise.change_noise_fraction = 0.5;
+  CommandNoiseParams noise = TestCommandNoise();
   noise.v_noise_scale = 0.5;
   noise.w_noise_scale = 3.0;
   const MotionInput input = CommandInput(Twist2{0.5, -0.4}, 0.2, noise, Twist2{0.3, 0.8});
@@ -412,6 +414,28 @@ TEST(MotionModelTest, CommandNoiseScalesMultiplyEachSigma) {
   for (const ParamProblem& problem : noise.Validate()) keys += problem.key + " ";
   EXPECT_NE(keys.find("v_noise_scale"), std::string::npos) << keys;
   EXPECT_NE(keys.find("w_noise_scale"), std::string::npos) << keys;
+}
+
+// The settle term widens each sigma by its fraction of the command's change
+// one record earlier (the wheels still settling), of its own component only,
+// and the factors multiply it too.
+TEST(MotionModelTest, SettleNoiseFollowsThePreviousChange) {
+  CommandNoiseParams noise = TestCommandNoise();
+  noise.settle_noise_fraction = 0.25;
+  const Twist2 command{0.5, -0.4};
+  const MotionInput held = CommandInput(command, 0.2, noise, command);
+  EXPECT_NEAR(std::sqrt(held.covariance(0, 0)), 0.2 * (0.02 + 0.05), 1e-12);
+  const MotionInput settling =
+      CommandInput(command, 0.2, noise, command, 1.0, 1.0, nullptr, Twist2{0.2, -1.2});
+  EXPECT_NEAR(std::sqrt(settling.covariance(0, 0)), 0.2 * (0.02 + 0.05 + 0.05), 1e-12);
+  EXPECT_NEAR(std::sqrt(settling.covariance(1, 1)), 0.2 * (0.01 + 0.08 + 0.3), 1e-12);
+  noise.w_noise_scale = 2.0;
+  const MotionInput scaled =
+      CommandInput(command, 0.2, noise, command, 1.0, 1.0, nullptr, Twist2{0.2, -1.2});
+  EXPECT_NEAR(std::sqrt(scaled.covariance(1, 1)), 2.0 * 0.2 * (0.01 + 0.08 + 0.3), 1e-12);
+  noise.settle_noise_fraction = -0.1;
+  ASSERT_EQ(noise.Validate().size(), 1u);
+  EXPECT_EQ(noise.Validate()[0].key, "settle_noise_fraction");
 }
 
 TEST(MotionModelTest, OdometryInputIsTheIncrementInThePreviousFrame) {
