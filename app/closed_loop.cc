@@ -101,6 +101,7 @@ const explorer::Explorer* ClosedLoop::explorer() const {
 }
 
 const LoopStep& ClosedLoop::Step() {
+  laps_.Start();
   out_ = LoopStep();
   out_.index = step_;
   // What the robot reports: odometry, the command it held, maybe a scan.
@@ -119,6 +120,7 @@ void ClosedLoop::Sense() {
     SenseWorld();
   } else {
     ReadRecording();
+    laps_.Start();  // reading a recording is no phase
   }
   previous_t_s_ = out_.record.t_s;
 }
@@ -136,23 +138,21 @@ void ClosedLoop::SenseWorld() {
   record.command = applied_;
   // The odometry pose as written to trajectory.csv (frame O placed at the
   // start pose in W), so that a replay feeds the filters the same bits.
-  {
-    const ScopedCpuTimer timer(&cpu_.odometry_s);
-    record.X_OR = X_WR0_ * w.odometry.Update(w.simulator.WheelAngles());
-  }
+  record.X_OR = X_WR0_ * w.odometry.Update(w.simulator.WheelAngles());
+  laps_.Charge(&cpu_.odometry_s);
   record.has_scan = step_ % config_.StepsPerScan() == 0;
   out_.X_WS_true = w.simulator.X_WS();
   if (record.has_scan) {
-    const ScopedCpuTimer timer(&cpu_.laser_s);
     const std::vector<double> jitter = w.laser_noise.DrawAngleOffsets();
     record.scan = w.laser_noise.Apply(w.simulator.CastLaser(config_.laser, jitter));
     record.scan.t_s = t;
+    laps_.Charge(&cpu_.laser_s);
   }
-  const ScopedCpuTimer coverage_timer(&cpu_.coverage_s);
   if (record.has_scan) w.coverage->Observe(out_.X_WS_true, record.scan);
   const double explored = w.coverage->ExploredFraction();
   if (!w.t90 && explored >= 0.90) w.t90 = t;
   if (!w.t99 && explored >= 0.99) w.t99 = t;
+  laps_.Charge(&cpu_.coverage_s);
 
   out_.row.t_s = t;
   out_.row.X_WR_true = X_WR;
@@ -191,20 +191,20 @@ void ClosedLoop::ReadRecording() {
 }
 
 void ClosedLoop::RunFilters() {
-  const ScopedCpuTimer timer(&cpu_.filters_s);
   slam_->Step(out_.record);
   const Pose2& X_WR = out_.row.X_WR_true;
   out_.row.filters = slam_->Rows(Pose2(X_WR.x, X_WR.y, X_WR.theta));
+  laps_.Charge(&cpu_.filters_s);
 }
 
 void ClosedLoop::Drive() {
-  const ScopedCpuTimer timer(&cpu_.explorer_s);
   if (world_) {
     DriveInWorld();
   } else {
     applied_ = out_.row.command;  // a recording brings its own commands
   }
   out_.row.command = applied_;
+  laps_.Charge(&cpu_.explorer_s);
 }
 
 // The controller issues a command when the last period has run out; the
@@ -247,12 +247,12 @@ void ClosedLoop::Advance() {
   finished_ = out_.finished;
   if (world_ && !finished_ && step_ < last_step_) {
     World& w = *world_;
-    const ScopedCpuTimer timer(&cpu_.physics_s);
     w.simulator.Advance(dt_s_);
     const int contacts = w.simulator.CountRobotWorldContacts();
     if (contacts > 0) ++w.contact_steps;
     if (contacts > 0 && !w.in_contact) ++w.collisions;
     w.in_contact = contacts > 0;
+    laps_.Charge(&cpu_.physics_s);
   }
   ++step_;
 }

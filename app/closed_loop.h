@@ -114,6 +114,8 @@ class ClosedLoop {
   bool finished_ = false;
   LoopStep out_;
   PhaseCpu cpu_;
+  // The clock of cpu_: each phase of a step is charged when it ends.
+  CpuLaps laps_;
 };
 
 }  // namespace mjslam::app

@@ -185,15 +185,34 @@ void ClearanceField::RecomputeBox(int x0, int y0, int x1, int y1) {
   d_.resize(n);
   v_.resize(n);
   z_.resize(n + 1);
-  // Columns over the input rows, kept for the rows of the box only.
+  // Columns over the input rows, kept for the rows of the box only. A
+  // column without an occupied cell transforms to kFar everywhere (each
+  // sample is its own nearest, exactly), so it is filled, not transformed.
   squared_.resize(static_cast<size_t>(w) * rows);
+  bool any_occupied = false;
   for (int ix = ix0; ix < ix1; ++ix) {
-    for (int iy = iy0; iy < iy1; ++iy) f_[iy - iy0] = occupied_(ix, iy) ? 0.0 : kFar;
-    DistanceTransform1d(f_.data(), h, d_.data(), v_.data(), z_.data());
-    for (int iy = y0; iy < y1; ++iy) squared_[(iy - y0) * w + (ix - ix0)] = d_[iy - iy0];
+    bool column_occupied = false;
+    for (int iy = iy0; iy < iy1; ++iy) {
+      const bool occupied = occupied_(ix, iy) != 0;
+      f_[iy - iy0] = occupied ? 0.0 : kFar;
+      column_occupied = column_occupied || occupied;
+    }
+    any_occupied = any_occupied || column_occupied;
+    if (column_occupied) DistanceTransform1d(f_.data(), h, d_.data(), v_.data(), z_.data());
+    for (int iy = y0; iy < y1; ++iy) {
+      squared_[(iy - y0) * w + (ix - ix0)] = column_occupied ? d_[iy - iy0] : kFar;
+    }
   }
-  // Rows, then the capped clearance of the box's cells.
+  // Rows, then the capped clearance of the box's cells. Without an occupied
+  // cell every row is kFar throughout, and every clearance the same value.
   const double r = limits_.resolution();
+  if (!any_occupied) {
+    const float far = static_cast<float>(std::min(std::sqrt(kFar) * r, cap_m_));
+    for (int iy = y0; iy < y1; ++iy) {
+      for (int ix = x0; ix < x1; ++ix) clearance_(ix, iy) = far;
+    }
+    return;
+  }
   for (int iy = y0; iy < y1; ++iy) {
     DistanceTransform1d(&squared_[(iy - y0) * w], w, d_.data(), v_.data(), z_.data());
     for (int ix = x0; ix < x1; ++ix) {

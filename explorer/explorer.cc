@@ -343,7 +343,7 @@ void Explorer::CheckGoal(const Pose2& X_WR, bool new_scan, double t_s) {
   // Reached, explored meanwhile, failed (no progress, or blocked too long).
   if (has_goal_ && tracker_.done()) DropGoal(true, false);
   if (has_goal_ && new_scan &&
-      InformationGain(grid_, frontier_W_, params_.gain_radius_m) < params_.min_gain_m2) {
+      !HasInformationGain(grid_, frontier_W_, params_.gain_radius_m, params_.min_gain_m2)) {
     DropGoal(false);
   }
   if (has_goal_) {

@@ -120,8 +120,13 @@ std::vector<Eigen::Vector2d> GlobalFrontierPoints(const OccupancyGrid& grid,
 // it just tested is skipped (same answer), and each unknown cell is counted
 // once through a stamp over the box of cells the rays can reach. Same count,
 // bit for bit, as testing every sample and sorting the cells
-// (tests/explorer/frontiers_test.cc checks it against that).
-double InformationGain(const OccupancyGrid& grid, const Eigen::Vector2d& p_W, double radius_m) {
+// (tests/explorer/frontiers_test.cc checks it against that). With a finite
+// `stop_at_m2`, it returns as soon as the area counted so far reaches it
+// (the count only grows, so "at least stop_at_m2" is then decided).
+namespace {
+
+double CountGain(const OccupancyGrid& grid, const Eigen::Vector2d& p_W, double radius_m,
+                 double stop_at_m2) {
   const double r = grid.resolution();
   const int num_rays = std::max(16, static_cast<int>(std::ceil(2.0 * kPi * radius_m / r)));
   const int steps = static_cast<int>(std::ceil(radius_m / (0.5 * r)));
@@ -158,8 +163,10 @@ double InformationGain(const OccupancyGrid& grid, const Eigen::Vector2d& p_W, do
       const int by = c.y() - center.y() + reach;
       if (bx >= 0 && bx < side && by >= 0 && by < side) {
         std::uint8_t& stamp = counted[static_cast<std::size_t>(by) * side + bx];
-        unique += stamp == 0;
+        if (stamp != 0) continue;
         stamp = 1;
+        ++unique;
+        if (unique * r * r >= stop_at_m2) return unique * r * r;
       } else {
         outside.push_back((static_cast<long long>(c.y()) << 32) ^ static_cast<unsigned int>(c.x()));
       }
@@ -168,6 +175,17 @@ double InformationGain(const OccupancyGrid& grid, const Eigen::Vector2d& p_W, do
   std::sort(outside.begin(), outside.end());
   unique += std::unique(outside.begin(), outside.end()) - outside.begin();
   return unique * r * r;
+}
+
+}  // namespace
+
+double InformationGain(const OccupancyGrid& grid, const Eigen::Vector2d& p_W, double radius_m) {
+  return CountGain(grid, p_W, radius_m, std::numeric_limits<double>::infinity());
+}
+
+bool HasInformationGain(const OccupancyGrid& grid, const Eigen::Vector2d& p_W, double radius_m,
+                        double min_gain_m2) {
+  return CountGain(grid, p_W, radius_m, min_gain_m2) >= min_gain_m2;
 }
 
 }  // namespace mjslam::explorer

@@ -39,4 +39,11 @@ std::vector<Eigen::Vector2d> GlobalFrontierPoints(const OccupancyGrid& grid,
 /// through a one-cell hole in a wall), m^2.
 double InformationGain(const OccupancyGrid& grid, const Eigen::Vector2d& p_W, double radius_m);
 
+/// Whether InformationGain(grid, p_W, radius_m) >= `min_gain_m2`, decided
+/// the same way for every input, but returning as soon as the unknown area
+/// counted so far reaches `min_gain_m2` (a goal's frontier that still has
+/// gain, the common case, costs a fraction of the full count).
+bool HasInformationGain(const OccupancyGrid& grid, const Eigen::Vector2d& p_W, double radius_m,
+                        double min_gain_m2);
+
 }  // namespace mjslam::explorer

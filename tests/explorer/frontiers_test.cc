@@ -157,14 +157,25 @@ TEST(FrontiersTest, GainEqualsCountingEverySample) {
     grid.InsertScan(sim.Scan(0.0), sim.X_WR() * config.X_RS);
   }
   int nonzero = 0;
+  int decided_below = 0;
   for (int i = 0; i < 300; ++i) {
     const Eigen::Vector2d p(-2.0 + 12.0 * rng.Uniform(), -2.0 + 10.0 * rng.Uniform());
     const double radius = i % 3 == 0 ? 1.5 : 0.2 + 3.0 * rng.Uniform();
     const double expected = GainBySorting(grid, p, radius);
     EXPECT_EQ(InformationGain(grid, p, radius), expected) << p.transpose() << " r " << radius;
     nonzero += expected > 0.0;
+    // The early-stopping test decides as the full count does, at thresholds
+    // just below, at and just above the gain, and at the default minimum.
+    const double r2 = grid.resolution() * grid.resolution();
+    for (const double min_gain : {expected - r2, expected, expected + r2, 0.5 * expected,
+                                  r2, 0.4}) {
+      EXPECT_EQ(HasInformationGain(grid, p, radius, min_gain), expected >= min_gain)
+          << p.transpose() << " r " << radius << " min " << min_gain;
+      decided_below += expected < min_gain;
+    }
   }
   EXPECT_GT(nonzero, 100);  // the comparison is not of zeros
+  EXPECT_GT(decided_below, 300);  // both answers occur
 }
 
 }  // namespace
