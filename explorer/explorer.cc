@@ -59,6 +59,13 @@ constexpr double kMaxBackOutM = 1.0;
 // A path that starts with a turn in place of more than this reverses the
 // robot's direction, degrees.
 constexpr double kReverseDeg = 90.0;
+// The turn that faces a frontier point at a goal reached ends within this
+// bearing, degrees, or after this time, seconds.
+constexpr double kFacedDeg = 5.0;
+constexpr double kMaxFaceS = 8.0;
+// A second look at a frontier point looks along the way into the unknown
+// beyond it, within this angle, degrees.
+constexpr double kSecondLookDeg = 20.0;
 
 // Whether no occupied cell lies on the segment from `from_W` to `to_W` (the
 // cell of `to_W` excluded): a viewpoint must see its frontier point.
@@ -72,6 +79,34 @@ bool SeesPoint(const OccupancyGrid& grid, const Eigen::Vector2d& from_W,
     }
   });
   return clear;
+}
+
+// The unit direction from `p_W` into the unknown around it: the mean of the
+// unit vectors of rays from it, each weighted by the unknown cells it
+// crosses within `radius_m` before an occupied cell (so that the unknown
+// behind a wall, outside the building, does not count); zero when none.
+Eigen::Vector2d UnknownDirection(const OccupancyGrid& grid, const Eigen::Vector2d& p_W,
+                                 double radius_m) {
+  constexpr int kRays = 72;
+  const double step = grid.resolution();
+  Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+  for (int k = 0; k < kRays; ++k) {
+    const double angle = 2.0 * kPi * k / kRays;
+    const Eigen::Vector2d u(std::cos(angle), std::sin(angle));
+    int unknown = 0;
+    for (double s = step; s <= radius_m; s += step) {
+      const Eigen::Vector2i c = grid.CellOf(p_W + s * u);
+      if (!grid.Contains(c.x(), c.y())) {
+        unknown += static_cast<int>((radius_m - s) / step) + 1;
+        break;
+      }
+      const CellState state = grid.State(c.x(), c.y());
+      if (state == CellState::kOccupied) break;
+      if (state == CellState::kUnknown) ++unknown;
+    }
+    sum += unknown * u;
+  }
+  return sum.norm() > 0.0 ? Eigen::Vector2d(sum.normalized()) : Eigen::Vector2d::Zero();
 }
 
 }  // namespace
@@ -104,13 +139,15 @@ std::vector<ExplorerLogRow> Explorer::LogRows() const {
   return rows;
 }
 
-bool Explorer::Blacklisted(const Eigen::Vector2d& p_W, bool* failed) const {
+bool Explorer::Blacklisted(const Eigen::Vector2d& p_W, bool* failed, int* looks) const {
   bool near = false;
   if (failed != nullptr) *failed = false;
+  if (looks != nullptr) *looks = 0;
   for (size_t i = 0; i < blacklist_.size(); ++i) {
     if ((blacklist_[i] - p_W).norm() < params_.blacklist_radius_m) {
       near = true;
       if (failed != nullptr && blacklist_failed_[i]) *failed = true;
+      if (looks != nullptr && !blacklist_failed_[i] && blacklist_frontier_[i]) ++*looks;
     }
   }
   return near;
@@ -122,9 +159,12 @@ void Explorer::DropGoal(bool blacklist, bool failed) {
     blacklist_.push_back(goal_W_);
     blacklist_failed_.push_back(failed ? 1 : 0);
     blacklist_failed_.push_back(failed ? 1 : 0);
+    blacklist_frontier_.push_back(1);
+    blacklist_frontier_.push_back(0);
   }
   has_goal_ = false;
   backing_out_ = false;
+  facing_ = false;
   tracker_.Clear();
   ++log_version_;
 }
@@ -203,13 +243,15 @@ std::vector<Explorer::Candidate> Explorer::ScoreFrontiers(
     const double gain = InformationGain(grid_, p, params_.gain_radius_m);
     if (gain < params_.min_gain_m2) continue;
     bool failed = false;
-    if (Blacklisted(p, &failed)) {
-      *unreachable = *unreachable || failed;
-      continue;
-    }
+    int looks = 0;
+    const bool blacklisted = Blacklisted(p, &failed, &looks);
+    if (blacklisted) *unreachable = *unreachable || failed;
+    // Near a goal reached once (the robot looked from there and gain is
+    // left: a strip seen at a slant from its mouth): a second look.
+    if (blacklisted && (failed || looks != 1)) continue;
     frontier_points_.push_back(p);
     pending.push_back({p, p, params_.gain_weight_per_m2 * gain,
-                       static_cast<int>(pending.size())});
+                       static_cast<int>(pending.size()), blacklisted});
   }
   // Their viewpoints' costs: the search grows (doubling its cost bound)
   // until the best candidate costed cannot be beaten by one still pending,
@@ -221,7 +263,19 @@ std::vector<Explorer::Candidate> Explorer::ScoreFrontiers(
     const double reach = map.expanded_cost();
     std::vector<Candidate> still;
     for (Candidate& candidate : pending) {
-      const double cost = BestViewpoint(map, candidate.frontier_W, &candidate.goal_W);
+      double cost = std::numeric_limits<double>::infinity();
+      if (!candidate.second_look) {
+        cost = BestViewpoint(map, candidate.frontier_W, params_.view_distance_m, false, false,
+                             &candidate.goal_W);
+      }
+      // No viewpoint near the point in the whole reachable map (a strip too
+      // narrow to turn in), or a second look: one within max_view_distance_m
+      // from which the laser sees it, not near a goal already tried (the
+      // robot looked from there).
+      if (!std::isfinite(cost) && !std::isfinite(reach)) {
+        cost = BestViewpoint(map, candidate.frontier_W, params_.max_view_distance_m, true,
+                             candidate.second_look, &candidate.goal_W);
+      }
       // Final: every cell not settled costs more than `reach`.
       const bool known = std::isfinite(cost) && cost <= reach;
       bool failed = false;
@@ -231,7 +285,9 @@ std::vector<Explorer::Candidate> Explorer::ScoreFrontiers(
         candidate.score -= cost;
         candidates.push_back(candidate);
       } else if (!std::isfinite(reach)) {
-        *unreachable = true;  // searched everything: no reachable viewpoint
+        // Searched everything: no reachable viewpoint (a second look that
+        // finds none leaves a point already reached).
+        *unreachable = *unreachable || !candidate.second_look;
       } else {
         still.push_back(candidate);
       }
@@ -250,9 +306,13 @@ std::vector<Explorer::Candidate> Explorer::ScoreFrontiers(
 }
 
 double Explorer::BestViewpoint(const NavigationMap& map, const Eigen::Vector2d& p_W,
+                               double radius_m, bool far, bool second_look,
                                Eigen::Vector2d* viewpoint_W) const {
+  const Eigen::Vector2d beyond =
+      second_look ? UnknownDirection(grid_, p_W, params_.gain_radius_m) : Eigen::Vector2d::Zero();
+  const double min_cos = std::cos(DegToRad(kSecondLookDeg));
   const double r = grid_.resolution();
-  const int window = static_cast<int>(std::ceil(params_.view_distance_m / r));
+  const int window = static_cast<int>(std::ceil(radius_m / r));
   const Eigen::Vector2i c = grid_.CellOf(p_W);
   double best = std::numeric_limits<double>::infinity();
   for (int iy = c.y() - window; iy <= c.y() + window; ++iy) {
@@ -264,14 +324,58 @@ double Explorer::BestViewpoint(const NavigationMap& map, const Eigen::Vector2d& 
       }
       const Eigen::Vector2d cell = grid_.CellCenter(ix, iy);
       const double distance = (cell - p_W).norm();
-      if (distance > params_.view_distance_m) continue;
-      if (cost + 2.0 * distance < best && SeesPoint(grid_, cell, p_W)) {
+      if (distance > radius_m || cost + 2.0 * distance >= best) continue;
+      if (second_look && !((p_W - cell).dot(beyond) >= min_cos * distance)) continue;
+      if (LaserSees(cell, p_W) && !(far && Blacklisted(cell))) {
         best = cost + 2.0 * distance;
         *viewpoint_W = cell;
       }
     }
   }
   return best;
+}
+
+bool Explorer::LaserSees(const Eigen::Vector2d& axle_W, const Eigen::Vector2d& p_W) const {
+  // Facing the point, the laser sits laser_ahead_m_ along the line from the
+  // axle to it (at the axle when the point is nearer than that).
+  const Eigen::Vector2d to = p_W - axle_W;
+  const double distance = to.norm();
+  const Eigen::Vector2d laser_W =
+      distance > laser_ahead_m_ ? Eigen::Vector2d(axle_W + laser_ahead_m_ / distance * to)
+                                : axle_W;
+  return (p_W - laser_W).norm() <= params_.max_insert_range_m && SeesPoint(grid_, laser_W, p_W);
+}
+
+void Explorer::ArriveAtGoal(const Pose2& X_WR, double t_s) {
+  const Eigen::Vector2d axle = AxleOf(X_WR);
+  const Eigen::Vector2d to = frontier_W_ - axle;
+  const double error = WrapAngle(std::atan2(to.y(), to.x()) - X_WR.theta);
+  clearance_.Update(grid_);
+  const Eigen::Vector2i cell = grid_.CellOf(axle);
+  const bool room = grid_.Contains(cell.x(), cell.y()) &&
+                    clearance_.Clearance(cell.x(), cell.y()) >= params_.turn_clearance_m;
+  if (std::abs(error) > DegToRad(params_.face_frontier_deg) && room) {
+    facing_ = true;
+    facing_since_s_ = t_s;
+    blocked_total_s_ = 0.0;
+    return;
+  }
+  DropGoal(true, false);
+}
+
+Twist2 Explorer::FaceFrontier(const Pose2& X_WR, double t_s, double dt_s) {
+  const Eigen::Vector2d to = frontier_W_ - AxleOf(X_WR);
+  const double error = WrapAngle(std::atan2(to.y(), to.x()) - X_WR.theta);
+  Twist2 target;
+  if (std::abs(error) < DegToRad(kFacedDeg) || t_s - facing_since_s_ > kMaxFaceS ||
+      blocked_total_s_ > params_.blocked_timeout_s) {
+    DropGoal(true, false);
+  } else {
+    const double w_max = params_.max_angular_speed_radps;
+    target.w_radps = std::clamp(params_.turn_gain_per_s * error, -w_max, w_max);
+  }
+  return RateLimit(tracker_.last_command(), target, params_.max_linear_accel_mps2 * dt_s,
+                   params_.max_angular_accel_radps2 * dt_s);
 }
 
 void Explorer::ChooseGoal(const Pose2& X_WR, double t_s) {
@@ -316,6 +420,7 @@ void Explorer::InsertScan(const Pose2& X_WR, const LaserScan& scan, const Pose2&
   grid_.MarkRectangleFree(X_WR, params_.body_rear_x_m, params_.body_front_x_m,
                           params_.body_half_width_m);
   local_points_ = LocalFrontierPoints(scan, X_WS, params_);
+  laser_ahead_m_ = std::max(0.0, a_m_ + X_RS.x);
   scan_points_W_.clear();
   for (int i = 0; i < scan.size(); ++i) {
     if (scan.has_return[i] == 0 || scan.ranges_m[i] >= scan.max_range_m) continue;
@@ -340,8 +445,10 @@ Twist2 Explorer::InitialTurn(const Pose2& X_WR, double dt_s) {
 }
 
 void Explorer::CheckGoal(const Pose2& X_WR, bool new_scan, double t_s) {
-  // Reached, explored meanwhile, failed (no progress, or blocked too long).
-  if (has_goal_ && tracker_.done()) DropGoal(true, false);
+  // Reached (then facing the frontier point first), explored meanwhile,
+  // failed (no progress, or blocked too long).
+  if (has_goal_ && tracker_.done()) ArriveAtGoal(X_WR, t_s);
+  if (facing_) return;
   if (has_goal_ && new_scan &&
       InformationGain(grid_, frontier_W_, params_.gain_radius_m) < params_.min_gain_m2) {
     DropGoal(false);
@@ -456,16 +563,21 @@ ExplorerOutput Explorer::Step(const Pose2& X_WR, const LaserScan* scan, const Po
   // the goal (kept, replaced or replanned first).
   Twist2 command;
   if (phase_ == Phase::kInitialTurn) command = InitialTurn(X_WR, dt_s);
+  if (phase_ == Phase::kExploring && facing_) command = FaceFrontier(X_WR, t_s, dt_s);
   if (phase_ == Phase::kExploring && backing_out_) command = BackOut(X_WR, t_s, dt_s);
-  if (phase_ == Phase::kExploring && !backing_out_) {
+  if (phase_ == Phase::kExploring && !backing_out_ && !facing_) {
     CheckGoal(X_WR, scan != nullptr, t_s);
-    if (!has_goal_) {
-      ChooseGoal(X_WR, t_s);
-    } else if (ScanBlocksPath() || t_s - last_plan_t_s_ >= params_.replan_period_s) {
-      Replan(X_WR, t_s);
+    if (facing_) {
+      command = FaceFrontier(X_WR, t_s, dt_s);
+    } else {
+      if (!has_goal_) {
+        ChooseGoal(X_WR, t_s);
+      } else if (ScanBlocksPath() || t_s - last_plan_t_s_ >= params_.replan_period_s) {
+        Replan(X_WR, t_s);
+      }
+      if (!finished_ && !backing_out_) command = tracker_.Command(X_WR, dt_s);
+      if (!finished_ && backing_out_) command = BackOut(X_WR, t_s, dt_s);
     }
-    if (!finished_ && !backing_out_) command = tracker_.Command(X_WR, dt_s);
-    if (!finished_ && backing_out_) command = BackOut(X_WR, t_s, dt_s);
   }
 
   if (finished_) {

@@ -48,8 +48,10 @@ struct EpisodeResult {
 // Runs the explorer from `X_WR0` among `walls` for at most `duration_s`;
 // the seen fraction is of the area reachable in `seen_walls`.
 EpisodeResult RunEpisodeIn(const std::vector<Wall>& walls, const std::vector<Wall>& seen_walls,
-                           const Pose2& X_WR0, double duration_s) {
+                           const Pose2& X_WR0, double duration_s,
+                           double laser_range_m = 4.0) {
   KinematicSim::Config config;
+  config.max_range_m = laser_range_m;
   KinematicSim sim(walls, X_WR0, config);
   Explorer explorer(ExplorerParams{}, config.a_m);
   testing::SeenArea seen(seen_walls, X_WR0.translation());
@@ -168,6 +170,35 @@ TEST(ExplorerClosedLoopTest, EntersARoomThroughAStandardDoor) {
     EXPECT_TRUE(result.finished);
     EXPECT_EQ(result.reason, "no_frontier");
     EXPECT_GE(deepest_y, 1.6 + 0.5);
+    EXPECT_GE(result.explored, 0.99);
+    EXPECT_EQ(result.contacts, 0);
+  }
+}
+
+// A hall of 4 x 4 m with a dead-end strip 0.7 m wide and 6 m long leaving
+// its bottom right corner to the east (y in [0, 0.7], x in [4, 10]), as
+// behind the south rooms of a generated floor: the axle cannot turn in the
+// strip (0.35 m of clearance in its middle), and the laser sees along it
+// only from the hall's bottom 0.7 m, facing east.
+std::vector<Wall> HallWithStrip() {
+  return {
+      {{0.0, 0.0}, {10.0, 0.0}}, {{10.0, 0.0}, {10.0, 0.7}}, {{4.0, 0.7}, {10.0, 0.7}},
+      {{4.0, 0.7}, {4.0, 4.0}},  {{0.0, 4.0}, {4.0, 4.0}},   {{0.0, 0.0}, {0.0, 4.0}},
+  };
+}
+
+// The strip is seen (it is a fifth of the reachable area): a viewpoint is
+// where the laser sees the frontier point with the heading the robot will
+// have there, and the robot faces the point on arrival. 10 m laser, as the
+// strip's far end is 6 m from its mouth.
+TEST(ExplorerClosedLoopTest, SeesADeadEndStripTooNarrowToTurnIn) {
+  const std::vector<Wall> walls = HallWithStrip();
+  for (const Pose2& start : {Pose2(1.0, 3.0, kPi), Pose2(2.0, 2.0, 0.5 * kPi)}) {
+    const EpisodeResult result = RunEpisodeIn(walls, walls, start, 300.0, 10.0);
+    std::printf("strip, start (%.1f, %.1f): %s after %.1f s, %.1f %% seen, %d contacts\n",
+                start.x, start.y, result.reason.c_str(), result.t_s, 100.0 * result.explored,
+                result.contacts);
+    EXPECT_TRUE(result.finished);
     EXPECT_GE(result.explored, 0.99);
     EXPECT_EQ(result.contacts, 0);
   }
