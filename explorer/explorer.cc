@@ -251,13 +251,16 @@ std::vector<Explorer::Candidate> Explorer::ScoreFrontiers(
     if (blacklisted && (failed || looks != 1)) continue;
     frontier_points_.push_back(p);
     pending.push_back({p, p, params_.gain_weight_per_m2 * gain,
-                       static_cast<int>(pending.size()), blacklisted});
+                       static_cast<int>(pending.size()), blacklisted, blacklisted});
   }
   // Their viewpoints' costs: the search grows (doubling its cost bound)
   // until the best candidate costed cannot be beaten by one still pending,
   // each of which costs more than the bound, so that a goal near the robot
-  // is found without searching the whole map.
+  // is found without searching the whole map. Far viewpoints (beyond
+  // view_distance_m) only when no candidate has a near one: they need the
+  // whole search.
   std::vector<Candidate> candidates;
+  std::vector<Candidate> far_candidates;
   for (double bound = kFirstSearchCostM; !pending.empty(); bound *= 2.0) {
     map.ExpandTo(bound);
     const double reach = map.expanded_cost();
@@ -268,37 +271,44 @@ std::vector<Explorer::Candidate> Explorer::ScoreFrontiers(
         cost = BestViewpoint(map, candidate.frontier_W, params_.view_distance_m, false, false,
                              &candidate.goal_W);
       }
-      // No viewpoint near the point in the whole reachable map (a strip too
-      // narrow to turn in), or a second look: one within max_view_distance_m
-      // from which the laser sees it, not near a goal already tried (the
-      // robot looked from there).
-      if (!std::isfinite(cost) && !std::isfinite(reach)) {
+      // Final when at most `reach`: every cell not settled costs more. A
+      // viewpoint near a goal tried (reached or failed) is no use: the robot
+      // looked from there.
+      bool failed = false;
+      const bool tried = cost <= reach && Blacklisted(candidate.goal_W, &failed);
+      candidate.far_only = candidate.far_only || tried;
+      if (std::isfinite(reach) && (tried || !(cost <= reach))) {
+        still.push_back(candidate);  // costed later, or looked at from afar
+        continue;
+      }
+      // Searched everything and no near viewpoint to try (a strip too narrow
+      // to turn in, a goal tried, a second look): one within
+      // max_view_distance_m from which the laser sees the point, away from
+      // the goals tried.
+      const bool far = tried || !std::isfinite(cost);
+      if (far) {
         cost = BestViewpoint(map, candidate.frontier_W, params_.max_view_distance_m, true,
                              candidate.second_look, &candidate.goal_W);
       }
-      // Final: every cell not settled costs more than `reach`.
-      const bool known = std::isfinite(cost) && cost <= reach;
-      bool failed = false;
-      if (known && Blacklisted(candidate.goal_W, &failed)) {
-        *unreachable = *unreachable || failed;
-      } else if (known) {
-        candidate.score -= cost;
-        candidates.push_back(candidate);
-      } else if (!std::isfinite(reach)) {
-        // Searched everything: no reachable viewpoint (a second look that
-        // finds none leaves a point already reached).
-        *unreachable = *unreachable || !candidate.second_look;
-      } else {
-        still.push_back(candidate);
+      if (!std::isfinite(cost)) {
+        // Unreachable: failed before, or no viewpoint at all (a point
+        // looked at from a goal reached is not).
+        *unreachable = *unreachable || failed || (!tried && !candidate.second_look);
+        continue;
       }
+      candidate.score -= cost;
+      (far ? far_candidates : candidates).push_back(candidate);
     }
     pending.swap(still);
     double best = -std::numeric_limits<double>::infinity();
     for (const Candidate& c : candidates) best = std::max(best, c.score);
     double pending_best = -std::numeric_limits<double>::infinity();
-    for (const Candidate& c : pending) pending_best = std::max(pending_best, c.score - reach);
+    for (const Candidate& c : pending) {
+      if (!c.far_only) pending_best = std::max(pending_best, c.score - reach);
+    }
     if (!candidates.empty() && best >= pending_best) break;
   }
+  if (candidates.empty()) candidates.swap(far_candidates);
   std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) {
     return a.score != b.score ? a.score > b.score : a.order < b.order;
   });

@@ -109,6 +109,8 @@ class Explorer {
     // Looked at once from a goal reached, gain left: seen again from a
     // viewpoint away from the goals tried, once nothing else is left.
     bool second_look = false;
+    // Its near viewpoint is a goal tried: only a far one will do.
+    bool far_only = false;
   };
 
   // The steps of Step(), in order.
