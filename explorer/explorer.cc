@@ -63,9 +63,9 @@ constexpr double kReverseDeg = 90.0;
 // bearing, degrees, or after this time, seconds.
 constexpr double kFacedDeg = 5.0;
 constexpr double kMaxFaceS = 8.0;
-// A second look at a frontier point looks along the way into the unknown
-// beyond it, within this angle, degrees.
-constexpr double kSecondLookDeg = 20.0;
+// A far viewpoint should look at its frontier point along the way into the
+// unknown beyond it: each radian between the two costs this much, metres.
+constexpr double kFarLookCostPerRad = 10.0;
 
 // Whether no occupied cell lies on the segment from `from_W` to `to_W` (the
 // cell of `to_W` excluded): a viewpoint must see its frontier point.
@@ -81,10 +81,12 @@ bool SeesPoint(const OccupancyGrid& grid, const Eigen::Vector2d& from_W,
   return clear;
 }
 
-// The unit direction from `p_W` into the unknown around it: the mean of the
-// unit vectors of rays from it, each weighted by the unknown cells it
-// crosses within `radius_m` before an occupied cell (so that the unknown
-// behind a wall, outside the building, does not count); zero when none.
+// The unit direction from `p_W` into the unknown around it: away from the
+// free space it is seen from, i.e. minus the mean of the unit vectors of
+// rays from it, each weighted by the free cells it crosses within `radius_m`
+// before the first cell that is not free (an unknown cell of a wall that was
+// only grazed, or the unknown outside the building, does not pull it);
+// zero when none.
 Eigen::Vector2d UnknownDirection(const OccupancyGrid& grid, const Eigen::Vector2d& p_W,
                                  double radius_m) {
   constexpr int kRays = 72;
@@ -93,18 +95,13 @@ Eigen::Vector2d UnknownDirection(const OccupancyGrid& grid, const Eigen::Vector2
   for (int k = 0; k < kRays; ++k) {
     const double angle = 2.0 * kPi * k / kRays;
     const Eigen::Vector2d u(std::cos(angle), std::sin(angle));
-    int unknown = 0;
+    int free = 0;
     for (double s = step; s <= radius_m; s += step) {
       const Eigen::Vector2i c = grid.CellOf(p_W + s * u);
-      if (!grid.Contains(c.x(), c.y())) {
-        unknown += static_cast<int>((radius_m - s) / step) + 1;
-        break;
-      }
-      const CellState state = grid.State(c.x(), c.y());
-      if (state == CellState::kOccupied) break;
-      if (state == CellState::kUnknown) ++unknown;
+      if (!grid.Contains(c.x(), c.y()) || grid.State(c.x(), c.y()) != CellState::kFree) break;
+      ++free;
     }
-    sum += unknown * u;
+    sum -= free * u;
   }
   return sum.norm() > 0.0 ? Eigen::Vector2d(sum.normalized()) : Eigen::Vector2d::Zero();
 }
@@ -123,6 +120,11 @@ Explorer::Explorer(const ExplorerParams& params, double a_m)
 std::optional<Eigen::Vector2d> Explorer::goal() const {
   if (!has_goal_) return std::nullopt;
   return goal_W_;
+}
+
+std::optional<Eigen::Vector2d> Explorer::goal_frontier() const {
+  if (!has_goal_) return std::nullopt;
+  return frontier_W_;
 }
 
 std::vector<ExplorerLogRow> Explorer::LogRows() const {
@@ -268,7 +270,7 @@ std::vector<Explorer::Candidate> Explorer::ScoreFrontiers(
     for (Candidate& candidate : pending) {
       double cost = std::numeric_limits<double>::infinity();
       if (!candidate.second_look) {
-        cost = BestViewpoint(map, candidate.frontier_W, params_.view_distance_m, false, false,
+        cost = BestViewpoint(map, candidate.frontier_W, params_.view_distance_m, false,
                              &candidate.goal_W);
       }
       // Final when at most `reach`: every cell not settled costs more. A
@@ -288,7 +290,7 @@ std::vector<Explorer::Candidate> Explorer::ScoreFrontiers(
       const bool far = tried || !std::isfinite(cost);
       if (far) {
         cost = BestViewpoint(map, candidate.frontier_W, params_.max_view_distance_m, true,
-                             candidate.second_look, &candidate.goal_W);
+                             &candidate.goal_W);
       }
       if (!std::isfinite(cost)) {
         // Unreachable: failed before, or no viewpoint at all (a point
@@ -316,11 +318,10 @@ std::vector<Explorer::Candidate> Explorer::ScoreFrontiers(
 }
 
 double Explorer::BestViewpoint(const NavigationMap& map, const Eigen::Vector2d& p_W,
-                               double radius_m, bool far, bool second_look,
+                               double radius_m, bool far,
                                Eigen::Vector2d* viewpoint_W) const {
   const Eigen::Vector2d beyond =
-      second_look ? UnknownDirection(grid_, p_W, params_.gain_radius_m) : Eigen::Vector2d::Zero();
-  const double min_cos = std::cos(DegToRad(kSecondLookDeg));
+      far ? UnknownDirection(grid_, p_W, params_.gain_radius_m) : Eigen::Vector2d::Zero();
   const double r = grid_.resolution();
   const int window = static_cast<int>(std::ceil(radius_m / r));
   const Eigen::Vector2i c = grid_.CellOf(p_W);
@@ -333,11 +334,16 @@ double Explorer::BestViewpoint(const NavigationMap& map, const Eigen::Vector2d& 
         continue;
       }
       const Eigen::Vector2d cell = grid_.CellCenter(ix, iy);
-      const double distance = (cell - p_W).norm();
-      if (distance > radius_m || cost + 2.0 * distance >= best) continue;
-      if (second_look && !((p_W - cell).dot(beyond) >= min_cos * distance)) continue;
+      const Eigen::Vector2d to = p_W - cell;
+      const double distance = to.norm();
+      double value = cost + 2.0 * distance;
+      if (far && beyond.squaredNorm() > 0.0 && distance > 0.0) {
+        const double cos_angle = std::clamp(to.dot(beyond) / distance, -1.0, 1.0);
+        value += kFarLookCostPerRad * std::acos(cos_angle);
+      }
+      if (distance > radius_m || value >= best) continue;
       if (LaserSees(cell, p_W) && !(far && Blacklisted(cell))) {
-        best = cost + 2.0 * distance;
+        best = value;
         *viewpoint_W = cell;
       }
     }

@@ -80,6 +80,8 @@ class Explorer {
   /// path (kind `path`), in W.
   const std::vector<Eigen::Vector2d>& frontier_points() const { return frontier_points_; }
   std::optional<Eigen::Vector2d> goal() const;
+  /// The frontier point the current goal views, in W (none without a goal).
+  std::optional<Eigen::Vector2d> goal_frontier() const;
   const Path& path() const { return tracker_.path(); }
   /// Incremented whenever the frontier points, the goal or the path change:
   /// write explorer.csv rows when it differs from the last one written.
@@ -106,7 +108,7 @@ class Explorer {
     Eigen::Vector2d goal_W;
     double score;
     int order;
-    // Looked at once from a goal reached, gain left: seen again from a
+    // Looked at once from a goal reached, gain left: seen again from a far
     // viewpoint away from the goals tried, once nothing else is left.
     bool second_look = false;
     // Its near viewpoint is a goal tried: only a far one will do.
@@ -155,11 +157,11 @@ class Explorer {
   // which the laser, facing the point, sees it), and that cell's centre in
   // `viewpoint_W` (untouched when there is none: the cost is infinite).
   // `far`: cells near a blacklisted point are no viewpoints (the robot
-  // looked from there); `second_look` in addition: the laser must look at
-  // the point along the way into the unknown beyond it (within
-  // kSecondLookDeg of UnknownDirection), e.g. along a strip.
+  // looked from there), and the laser must look at the point along the way
+  // into the unknown beyond it (within kFarLookDeg of UnknownDirection: a
+  // strip too narrow to turn in is seen along its length).
   double BestViewpoint(const NavigationMap& map, const Eigen::Vector2d& p_W, double radius_m,
-                       bool far, bool second_look, Eigen::Vector2d* viewpoint_W) const;
+                       bool far, Eigen::Vector2d* viewpoint_W) const;
   // Whether the laser, with the axle at `axle_W` and the robot facing
   // `p_W`, sees `p_W` (no occupied cell between them, within range).
   bool LaserSees(const Eigen::Vector2d& axle_W, const Eigen::Vector2d& p_W) const;

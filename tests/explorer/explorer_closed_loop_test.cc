@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -201,6 +202,37 @@ TEST(ExplorerClosedLoopTest, SeesADeadEndStripTooNarrowToTurnIn) {
     EXPECT_TRUE(result.finished);
     EXPECT_GE(result.explored, 0.99);
     EXPECT_EQ(result.contacts, 0);
+  }
+}
+
+// Every goal sees its frontier point: no wall crosses the segment from the
+// goal (the axle's cell) to the point (a goal behind a wall would be
+// reached and see nothing). In the corridor and room of the standard doors
+// and in the hall with the strip, exact walls, every goal of an episode.
+TEST(ExplorerClosedLoopTest, EveryGoalSeesItsFrontierPoint) {
+  for (const std::vector<Wall>& walls : {CorridorAndRoom(0.8), HallWithStrip()}) {
+    KinematicSim::Config config;
+    config.max_range_m = 10.0;
+    KinematicSim sim(walls, Pose2(1.0, 0.8, kPi), config);
+    Explorer explorer(ExplorerParams{}, config.a_m);
+    int goals = 0;
+    std::optional<Eigen::Vector2d> last_goal;
+    for (double t = 0.0; t < 200.0; t += 0.1) {
+      const LaserScan scan = sim.Scan(t);
+      const ExplorerOutput out = explorer.Step(sim.X_WR(), &scan, config.X_RS, t, 0.1);
+      if (out.finished) break;
+      const std::optional<Eigen::Vector2d> goal = explorer.goal();
+      if (goal && (!last_goal || *goal != *last_goal)) {
+        ++goals;
+        const Eigen::Vector2d to = *explorer.goal_frontier() - *goal;
+        // 5 cm: the point's cell may touch a wall.
+        EXPECT_GE(testing::CastRay(walls, *goal, to.normalized()), to.norm() - 0.05)
+            << "goal (" << goal->x() << ", " << goal->y() << ") at t = " << t;
+      }
+      last_goal = goal;
+      sim.Step(out.command, 0.1);
+    }
+    EXPECT_GE(goals, 3);
   }
 }
 
