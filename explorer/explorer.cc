@@ -166,6 +166,7 @@ void Explorer::DropGoal(bool blacklist, bool failed) {
   }
   has_goal_ = false;
   backing_out_ = false;
+  back_out_held_ = false;
   facing_ = false;
   tracker_.Clear();
   ++log_version_;
@@ -212,7 +213,7 @@ bool Explorer::PlanToGoal(const NavigationMap& map, const Pose2& X_WR, double t_
   // turn (a door, a narrow strip): back out straight first, the way it came.
   const double turn = std::abs(WrapAngle(path.front().heading_rad - X_WR.theta));
   backing_out_ = path.front().turn_in_place && turn > DegToRad(kReverseDeg) &&
-                 map.ClearanceAt(AxleOf(X_WR)) < params_.turn_clearance_m;
+                 map.ClearanceAt(AxleOf(X_WR)) < params_.turn_clearance_m && !back_out_held_;
   if (backing_out_) back_out_from_W_ = AxleOf(X_WR);
   tracker_.SetPath(std::move(path));
   ++log_version_;
@@ -227,6 +228,7 @@ Twist2 Explorer::BackOut(const Pose2& X_WR, double t_s, double dt_s) {
                     clearance_.Clearance(cell.x(), cell.y()) >= params_.turn_clearance_m;
   if (room || (axle - back_out_from_W_).norm() >= kMaxBackOutM || blocked_s_ > 0.0) {
     backing_out_ = false;
+    back_out_held_ = !room && blocked_s_ > 0.0;
     // Backing out to turning room is a manoeuvre, not a lack of progress.
     if (room) progress_t_s_ = t_s;
     Replan(X_WR, t_s);

@@ -232,6 +232,9 @@ class Explorer {
   // and where the axle was when it began.
   bool backing_out_ = false;
   Eigen::Vector2d back_out_from_W_ = Eigen::Vector2d::Zero();
+  // The safety layer held the last back-out for the current goal: no new
+  // one (the recovery takes over), or the two would alternate for ever.
+  bool back_out_held_ = false;
   // Turning in place at a goal reached to face its frontier point, since.
   bool facing_ = false;
   double facing_since_s_ = 0.0;
