@@ -59,6 +59,13 @@ constexpr double kMaxBackOutM = 1.0;
 // A path that starts with a turn in place of more than this reverses the
 // robot's direction, degrees.
 constexpr double kReverseDeg = 90.0;
+// The turn that faces a frontier point at a goal reached ends within this
+// bearing, degrees, or after this time, seconds.
+constexpr double kFacedDeg = 5.0;
+constexpr double kMaxFaceS = 8.0;
+// A far viewpoint should look at its frontier point along the way into the
+// unknown beyond it: each radian between the two costs this much, metres.
+constexpr double kFarLookCostPerRad = 10.0;
 
 // Whether no occupied cell lies on the segment from `from_W` to `to_W` (the
 // cell of `to_W` excluded): a viewpoint must see its frontier point.
@@ -72,6 +79,31 @@ bool SeesPoint(const OccupancyGrid& grid, const Eigen::Vector2d& from_W,
     }
   });
   return clear;
+}
+
+// The unit direction from `p_W` into the unknown around it: away from the
+// free space it is seen from, i.e. minus the mean of the unit vectors of
+// rays from it, each weighted by the free cells it crosses within `radius_m`
+// before the first cell that is not free (an unknown cell of a wall that was
+// only grazed, or the unknown outside the building, does not pull it);
+// zero when none.
+Eigen::Vector2d UnknownDirection(const OccupancyGrid& grid, const Eigen::Vector2d& p_W,
+                                 double radius_m) {
+  constexpr int kRays = 72;
+  const double step = grid.resolution();
+  Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+  for (int k = 0; k < kRays; ++k) {
+    const double angle = 2.0 * kPi * k / kRays;
+    const Eigen::Vector2d u(std::cos(angle), std::sin(angle));
+    int free = 0;
+    for (double s = step; s <= radius_m; s += step) {
+      const Eigen::Vector2i c = grid.CellOf(p_W + s * u);
+      if (!grid.Contains(c.x(), c.y()) || grid.State(c.x(), c.y()) != CellState::kFree) break;
+      ++free;
+    }
+    sum -= free * u;
+  }
+  return sum.norm() > 0.0 ? Eigen::Vector2d(sum.normalized()) : Eigen::Vector2d::Zero();
 }
 
 }  // namespace
@@ -90,6 +122,11 @@ std::optional<Eigen::Vector2d> Explorer::goal() const {
   return goal_W_;
 }
 
+std::optional<Eigen::Vector2d> Explorer::goal_frontier() const {
+  if (!has_goal_) return std::nullopt;
+  return frontier_W_;
+}
+
 std::vector<ExplorerLogRow> Explorer::LogRows() const {
   std::vector<ExplorerLogRow> rows;
   for (size_t i = 0; i < frontier_points_.size(); ++i) {
@@ -104,13 +141,15 @@ std::vector<ExplorerLogRow> Explorer::LogRows() const {
   return rows;
 }
 
-bool Explorer::Blacklisted(const Eigen::Vector2d& p_W, bool* failed) const {
+bool Explorer::Blacklisted(const Eigen::Vector2d& p_W, bool* failed, int* looks) const {
   bool near = false;
   if (failed != nullptr) *failed = false;
+  if (looks != nullptr) *looks = 0;
   for (size_t i = 0; i < blacklist_.size(); ++i) {
     if ((blacklist_[i] - p_W).norm() < params_.blacklist_radius_m) {
       near = true;
       if (failed != nullptr && blacklist_failed_[i]) *failed = true;
+      if (looks != nullptr && !blacklist_failed_[i] && blacklist_frontier_[i]) ++*looks;
     }
   }
   return near;
@@ -122,9 +161,13 @@ void Explorer::DropGoal(bool blacklist, bool failed) {
     blacklist_.push_back(goal_W_);
     blacklist_failed_.push_back(failed ? 1 : 0);
     blacklist_failed_.push_back(failed ? 1 : 0);
+    blacklist_frontier_.push_back(1);
+    blacklist_frontier_.push_back(0);
   }
   has_goal_ = false;
   backing_out_ = false;
+  back_out_held_ = false;
+  facing_ = false;
   tracker_.Clear();
   ++log_version_;
 }
@@ -170,7 +213,7 @@ bool Explorer::PlanToGoal(const NavigationMap& map, const Pose2& X_WR, double t_
   // turn (a door, a narrow strip): back out straight first, the way it came.
   const double turn = std::abs(WrapAngle(path.front().heading_rad - X_WR.theta));
   backing_out_ = path.front().turn_in_place && turn > DegToRad(kReverseDeg) &&
-                 map.ClearanceAt(AxleOf(X_WR)) < params_.turn_clearance_m;
+                 map.ClearanceAt(AxleOf(X_WR)) < params_.turn_clearance_m && !back_out_held_;
   if (backing_out_) back_out_from_W_ = AxleOf(X_WR);
   tracker_.SetPath(std::move(path));
   ++log_version_;
@@ -185,6 +228,7 @@ Twist2 Explorer::BackOut(const Pose2& X_WR, double t_s, double dt_s) {
                     clearance_.Clearance(cell.x(), cell.y()) >= params_.turn_clearance_m;
   if (room || (axle - back_out_from_W_).norm() >= kMaxBackOutM || blocked_s_ > 0.0) {
     backing_out_ = false;
+    back_out_held_ = !room && blocked_s_ > 0.0;
     // Backing out to turning room is a manoeuvre, not a lack of progress.
     if (room) progress_t_s_ = t_s;
     Replan(X_WR, t_s);
@@ -203,46 +247,72 @@ std::vector<Explorer::Candidate> Explorer::ScoreFrontiers(
     const double gain = InformationGain(grid_, p, params_.gain_radius_m);
     if (gain < params_.min_gain_m2) continue;
     bool failed = false;
-    if (Blacklisted(p, &failed)) {
-      *unreachable = *unreachable || failed;
-      continue;
-    }
+    int looks = 0;
+    const bool blacklisted = Blacklisted(p, &failed, &looks);
+    if (blacklisted) *unreachable = *unreachable || failed;
+    // Near a goal reached once (the robot looked from there and gain is
+    // left: a strip seen at a slant from its mouth): a second look.
+    if (blacklisted && (failed || looks != 1)) continue;
     frontier_points_.push_back(p);
     pending.push_back({p, p, params_.gain_weight_per_m2 * gain,
-                       static_cast<int>(pending.size())});
+                       static_cast<int>(pending.size()), blacklisted, blacklisted});
   }
   // Their viewpoints' costs: the search grows (doubling its cost bound)
   // until the best candidate costed cannot be beaten by one still pending,
   // each of which costs more than the bound, so that a goal near the robot
-  // is found without searching the whole map.
+  // is found without searching the whole map. Far viewpoints (beyond
+  // view_distance_m) only when no candidate has a near one: they need the
+  // whole search.
   std::vector<Candidate> candidates;
+  std::vector<Candidate> far_candidates;
   for (double bound = kFirstSearchCostM; !pending.empty(); bound *= 2.0) {
     map.ExpandTo(bound);
     const double reach = map.expanded_cost();
     std::vector<Candidate> still;
     for (Candidate& candidate : pending) {
-      const double cost = BestViewpoint(map, candidate.frontier_W, &candidate.goal_W);
-      // Final: every cell not settled costs more than `reach`.
-      const bool known = std::isfinite(cost) && cost <= reach;
-      bool failed = false;
-      if (known && Blacklisted(candidate.goal_W, &failed)) {
-        *unreachable = *unreachable || failed;
-      } else if (known) {
-        candidate.score -= cost;
-        candidates.push_back(candidate);
-      } else if (!std::isfinite(reach)) {
-        *unreachable = true;  // searched everything: no reachable viewpoint
-      } else {
-        still.push_back(candidate);
+      double cost = std::numeric_limits<double>::infinity();
+      if (!candidate.second_look) {
+        cost = BestViewpoint(map, candidate.frontier_W, params_.view_distance_m, false,
+                             &candidate.goal_W);
       }
+      // Final when at most `reach`: every cell not settled costs more. A
+      // viewpoint near a goal tried (reached or failed) is no use: the robot
+      // looked from there.
+      bool failed = false;
+      const bool tried = cost <= reach && Blacklisted(candidate.goal_W, &failed);
+      candidate.far_only = candidate.far_only || tried;
+      if (std::isfinite(reach) && (tried || !(cost <= reach))) {
+        still.push_back(candidate);  // costed later, or looked at from afar
+        continue;
+      }
+      // Searched everything and no near viewpoint to try (a strip too narrow
+      // to turn in, a goal tried, a second look): one within
+      // max_view_distance_m from which the laser sees the point, away from
+      // the goals tried.
+      const bool far = tried || !std::isfinite(cost);
+      if (far) {
+        cost = BestViewpoint(map, candidate.frontier_W, params_.max_view_distance_m, true,
+                             &candidate.goal_W);
+      }
+      if (!std::isfinite(cost)) {
+        // Unreachable: failed before, or no viewpoint at all (a point
+        // looked at from a goal reached is not).
+        *unreachable = *unreachable || failed || (!tried && !candidate.second_look);
+        continue;
+      }
+      candidate.score -= cost;
+      (far ? far_candidates : candidates).push_back(candidate);
     }
     pending.swap(still);
     double best = -std::numeric_limits<double>::infinity();
     for (const Candidate& c : candidates) best = std::max(best, c.score);
     double pending_best = -std::numeric_limits<double>::infinity();
-    for (const Candidate& c : pending) pending_best = std::max(pending_best, c.score - reach);
+    for (const Candidate& c : pending) {
+      if (!c.far_only) pending_best = std::max(pending_best, c.score - reach);
+    }
     if (!candidates.empty() && best >= pending_best) break;
   }
+  if (candidates.empty()) candidates.swap(far_candidates);
   std::sort(candidates.begin(), candidates.end(), [](const Candidate& a, const Candidate& b) {
     return a.score != b.score ? a.score > b.score : a.order < b.order;
   });
@@ -250,9 +320,12 @@ std::vector<Explorer::Candidate> Explorer::ScoreFrontiers(
 }
 
 double Explorer::BestViewpoint(const NavigationMap& map, const Eigen::Vector2d& p_W,
+                               double radius_m, bool far,
                                Eigen::Vector2d* viewpoint_W) const {
+  const Eigen::Vector2d beyond =
+      far ? UnknownDirection(grid_, p_W, params_.gain_radius_m) : Eigen::Vector2d::Zero();
   const double r = grid_.resolution();
-  const int window = static_cast<int>(std::ceil(params_.view_distance_m / r));
+  const int window = static_cast<int>(std::ceil(radius_m / r));
   const Eigen::Vector2i c = grid_.CellOf(p_W);
   double best = std::numeric_limits<double>::infinity();
   for (int iy = c.y() - window; iy <= c.y() + window; ++iy) {
@@ -263,15 +336,64 @@ double Explorer::BestViewpoint(const NavigationMap& map, const Eigen::Vector2d& 
         continue;
       }
       const Eigen::Vector2d cell = grid_.CellCenter(ix, iy);
-      const double distance = (cell - p_W).norm();
-      if (distance > params_.view_distance_m) continue;
-      if (cost + 2.0 * distance < best && SeesPoint(grid_, cell, p_W)) {
-        best = cost + 2.0 * distance;
+      const Eigen::Vector2d to = p_W - cell;
+      const double distance = to.norm();
+      double value = cost + 2.0 * distance;
+      if (far && beyond.squaredNorm() > 0.0 && distance > 0.0) {
+        const double cos_angle = std::clamp(to.dot(beyond) / distance, -1.0, 1.0);
+        value += kFarLookCostPerRad * std::acos(cos_angle);
+      }
+      if (distance > radius_m || value >= best) continue;
+      if (LaserSees(cell, p_W) && !(far && Blacklisted(cell))) {
+        best = value;
         *viewpoint_W = cell;
       }
     }
   }
   return best;
+}
+
+bool Explorer::LaserSees(const Eigen::Vector2d& axle_W, const Eigen::Vector2d& p_W) const {
+  // Facing the point, the laser sits laser_ahead_m_ along the line from the
+  // axle to it (at the axle when the point is nearer than that).
+  const Eigen::Vector2d to = p_W - axle_W;
+  const double distance = to.norm();
+  const Eigen::Vector2d laser_W =
+      distance > laser_ahead_m_ ? Eigen::Vector2d(axle_W + laser_ahead_m_ / distance * to)
+                                : axle_W;
+  return (p_W - laser_W).norm() <= params_.max_insert_range_m && SeesPoint(grid_, laser_W, p_W);
+}
+
+void Explorer::ArriveAtGoal(const Pose2& X_WR, double t_s) {
+  const Eigen::Vector2d axle = AxleOf(X_WR);
+  const Eigen::Vector2d to = frontier_W_ - axle;
+  const double error = WrapAngle(std::atan2(to.y(), to.x()) - X_WR.theta);
+  clearance_.Update(grid_);
+  const Eigen::Vector2i cell = grid_.CellOf(axle);
+  const bool room = grid_.Contains(cell.x(), cell.y()) &&
+                    clearance_.Clearance(cell.x(), cell.y()) >= params_.turn_clearance_m;
+  if (std::abs(error) > DegToRad(params_.face_frontier_deg) && room) {
+    facing_ = true;
+    facing_since_s_ = t_s;
+    blocked_total_s_ = 0.0;
+    return;
+  }
+  DropGoal(true, false);
+}
+
+Twist2 Explorer::FaceFrontier(const Pose2& X_WR, double t_s, double dt_s) {
+  const Eigen::Vector2d to = frontier_W_ - AxleOf(X_WR);
+  const double error = WrapAngle(std::atan2(to.y(), to.x()) - X_WR.theta);
+  Twist2 target;
+  if (std::abs(error) < DegToRad(kFacedDeg) || t_s - facing_since_s_ > kMaxFaceS ||
+      blocked_total_s_ > params_.blocked_timeout_s) {
+    DropGoal(true, false);
+  } else {
+    const double w_max = params_.max_angular_speed_radps;
+    target.w_radps = std::clamp(params_.turn_gain_per_s * error, -w_max, w_max);
+  }
+  return RateLimit(tracker_.last_command(), target, params_.max_linear_accel_mps2 * dt_s,
+                   params_.max_angular_accel_radps2 * dt_s);
 }
 
 void Explorer::ChooseGoal(const Pose2& X_WR, double t_s) {
@@ -316,6 +438,7 @@ void Explorer::InsertScan(const Pose2& X_WR, const LaserScan& scan, const Pose2&
   grid_.MarkRectangleFree(X_WR, params_.body_rear_x_m, params_.body_front_x_m,
                           params_.body_half_width_m);
   local_points_ = LocalFrontierPoints(scan, X_WS, params_);
+  laser_ahead_m_ = std::max(0.0, a_m_ + X_RS.x);
   scan_points_W_.clear();
   for (int i = 0; i < scan.size(); ++i) {
     if (scan.has_return[i] == 0 || scan.ranges_m[i] >= scan.max_range_m) continue;
@@ -340,8 +463,10 @@ Twist2 Explorer::InitialTurn(const Pose2& X_WR, double dt_s) {
 }
 
 void Explorer::CheckGoal(const Pose2& X_WR, bool new_scan, double t_s) {
-  // Reached, explored meanwhile, failed (no progress, or blocked too long).
-  if (has_goal_ && tracker_.done()) DropGoal(true, false);
+  // Reached (then facing the frontier point first), explored meanwhile,
+  // failed (no progress, or blocked too long).
+  if (has_goal_ && tracker_.done()) ArriveAtGoal(X_WR, t_s);
+  if (facing_) return;
   if (has_goal_ && new_scan &&
       !HasInformationGain(grid_, frontier_W_, params_.gain_radius_m, params_.min_gain_m2)) {
     DropGoal(false);
@@ -456,16 +581,21 @@ ExplorerOutput Explorer::Step(const Pose2& X_WR, const LaserScan* scan, const Po
   // the goal (kept, replaced or replanned first).
   Twist2 command;
   if (phase_ == Phase::kInitialTurn) command = InitialTurn(X_WR, dt_s);
+  if (phase_ == Phase::kExploring && facing_) command = FaceFrontier(X_WR, t_s, dt_s);
   if (phase_ == Phase::kExploring && backing_out_) command = BackOut(X_WR, t_s, dt_s);
-  if (phase_ == Phase::kExploring && !backing_out_) {
+  if (phase_ == Phase::kExploring && !backing_out_ && !facing_) {
     CheckGoal(X_WR, scan != nullptr, t_s);
-    if (!has_goal_) {
-      ChooseGoal(X_WR, t_s);
-    } else if (ScanBlocksPath() || t_s - last_plan_t_s_ >= params_.replan_period_s) {
-      Replan(X_WR, t_s);
+    if (facing_) {
+      command = FaceFrontier(X_WR, t_s, dt_s);
+    } else {
+      if (!has_goal_) {
+        ChooseGoal(X_WR, t_s);
+      } else if (ScanBlocksPath() || t_s - last_plan_t_s_ >= params_.replan_period_s) {
+        Replan(X_WR, t_s);
+      }
+      if (!finished_ && !backing_out_) command = tracker_.Command(X_WR, dt_s);
+      if (!finished_ && backing_out_) command = BackOut(X_WR, t_s, dt_s);
     }
-    if (!finished_ && !backing_out_) command = tracker_.Command(X_WR, dt_s);
-    if (!finished_ && backing_out_) command = BackOut(X_WR, t_s, dt_s);
   }
 
   if (finished_) {

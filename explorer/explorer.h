@@ -80,6 +80,8 @@ class Explorer {
   /// path (kind `path`), in W.
   const std::vector<Eigen::Vector2d>& frontier_points() const { return frontier_points_; }
   std::optional<Eigen::Vector2d> goal() const;
+  /// The frontier point the current goal views, in W (none without a goal).
+  std::optional<Eigen::Vector2d> goal_frontier() const;
   const Path& path() const { return tracker_.path(); }
   /// Incremented whenever the frontier points, the goal or the path change:
   /// write explorer.csv rows when it differs from the last one written.
@@ -106,6 +108,11 @@ class Explorer {
     Eigen::Vector2d goal_W;
     double score;
     int order;
+    // Looked at once from a goal reached, gain left: seen again from a far
+    // viewpoint away from the goals tried, once nothing else is left.
+    bool second_look = false;
+    // Its near viewpoint is a goal tried: only a far one will do.
+    bool far_only = false;
   };
 
   // The steps of Step(), in order.
@@ -145,11 +152,26 @@ class Explorer {
   std::vector<Candidate> ScoreFrontiers(NavigationMap& map,
                                         const std::vector<Eigen::Vector2d>& points,
                                         bool* unreachable);
-  // The least cost, path cost plus twice the distance, of a comfortable
-  // reachable cell within view_distance_m of `p_W`, and that cell's centre in
+  // The least cost, path cost plus twice the distance, of a viewpoint of
+  // `p_W` within `radius_m` (a reachable cell with turn_clearance_m from
+  // which the laser, facing the point, sees it), and that cell's centre in
   // `viewpoint_W` (untouched when there is none: the cost is infinite).
-  double BestViewpoint(const NavigationMap& map, const Eigen::Vector2d& p_W,
-                       Eigen::Vector2d* viewpoint_W) const;
+  // `far`: cells near a blacklisted point are no viewpoints (the robot
+  // looked from there), and the laser must look at the point along the way
+  // into the unknown beyond it (within kFarLookDeg of UnknownDirection: a
+  // strip too narrow to turn in is seen along its length).
+  double BestViewpoint(const NavigationMap& map, const Eigen::Vector2d& p_W, double radius_m,
+                       bool far, Eigen::Vector2d* viewpoint_W) const;
+  // Whether the laser, with the axle at `axle_W` and the robot facing
+  // `p_W`, sees `p_W` (no occupied cell between them, within range).
+  bool LaserSees(const Eigen::Vector2d& axle_W, const Eigen::Vector2d& p_W) const;
+  // Starts the turn that faces the goal's frontier point at a goal reached
+  // (when it is face_frontier_deg off and the axle has turning room);
+  // otherwise drops the goal as reached.
+  void ArriveAtGoal(const Pose2& X_WR, double t_s);
+  // One step of that turn; drops the goal as reached once the robot faces
+  // the point, or when the turn is held or takes too long.
+  Twist2 FaceFrontier(const Pose2& X_WR, double t_s, double dt_s);
   // Plans a path to the current goal; false when there is none. Starts a
   // back-out when the path reverses the robot's direction (a turn in place
   // of more than 90 deg first) where the axle lacks turn_clearance_m.
@@ -162,8 +184,10 @@ class Explorer {
   // `failed` (otherwise as reached).
   void DropGoal(bool blacklist, bool failed = true);
   // Whether a point is near a blacklisted one; `failed` (optional) tells
-  // whether one of those failed.
-  bool Blacklisted(const Eigen::Vector2d& p_W, bool* failed = nullptr) const;
+  // whether one of those failed, `looks` (optional) how many of those are
+  // frontier points of goals reached.
+  bool Blacklisted(const Eigen::Vector2d& p_W, bool* failed = nullptr,
+                   int* looks = nullptr) const;
   // Obstacle points near h: the last scan's echoes and occupied cells.
   std::vector<Eigen::Vector2d> NearbyObstacles(const Pose2& X_WR) const;
   // The centre of the axle, a_m behind h: the point the planner plans for.
@@ -183,6 +207,8 @@ class Explorer {
   std::vector<Eigen::Vector2d> blacklist_;
   // Per blacklist entry: 1 when the goal failed, 0 when it was reached.
   std::vector<std::uint8_t> blacklist_failed_;
+  // Per blacklist entry: 1 for a frontier point, 0 for a goal cell.
+  std::vector<std::uint8_t> blacklist_frontier_;
 
   bool has_goal_ = false;
   // The frontier point the goal serves, and the cell h drives to.
@@ -206,6 +232,14 @@ class Explorer {
   // and where the axle was when it began.
   bool backing_out_ = false;
   Eigen::Vector2d back_out_from_W_ = Eigen::Vector2d::Zero();
+  // The safety layer held the last back-out for the current goal: no new
+  // one (the recovery takes over), or the two would alternate for ever.
+  bool back_out_held_ = false;
+  // Turning in place at a goal reached to face its frontier point, since.
+  bool facing_ = false;
+  double facing_since_s_ = 0.0;
+  // How far the laser sits ahead of the axle (from the last scan's mount), m.
+  double laser_ahead_m_ = 0.0;
 
   double turned_rad_ = 0.0;
   double last_theta_ = 0.0;

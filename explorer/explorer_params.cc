@@ -44,6 +44,12 @@ std::vector<ParamProblem> ExplorerParams::Validate() const {
   check.NonNegative("min_gain_m2", min_gain_m2);
   check.NonNegative("gain_weight_per_m2", gain_weight_per_m2);
   check.Positive("view_distance_m", view_distance_m);
+  check.Require(max_view_distance_m >= view_distance_m &&
+                    max_view_distance_m <= max_insert_range_m,
+                "max_view_distance_m", max_view_distance_m,
+                "a value in [view_distance_m, max_insert_range_m]");
+  check.Require(face_frontier_deg > 0.0 && face_frontier_deg <= 180.0, "face_frontier_deg",
+                face_frontier_deg, "a value in (0, 180]");
   check.Require(min_frontier_cells >= 1, "min_frontier_cells", min_frontier_cells,
                 "a value >= 1");
   check.Positive("goal_tolerance_m", goal_tolerance_m);

@@ -100,6 +100,15 @@ struct ExplorerParams {
   /// The robot stops this close to a frontier point at the most, metres: the
   /// goal is the reachable cell within this distance of it.
   double view_distance_m = 0.8;
+  /// When the whole reachable map holds no viewpoint within view_distance_m
+  /// of a frontier point (a dead-end strip too narrow to turn in, seen only
+  /// along its length), the goal is the cell within this distance from which
+  /// the laser sees the point, metres (<= max_insert_range_m).
+  double max_view_distance_m = 4.0;
+  /// At a goal reached, the robot turns in place to face its frontier point
+  /// when the point lies more than this off its heading and the axle has
+  /// turn_clearance_m, degrees (180: never).
+  double face_frontier_deg = 20.0;
   /// Global frontier clusters with fewer cells are ignored.
   int min_frontier_cells = 6;
   /// The goal is reached when h is this close to the end of the path, metres.
@@ -187,6 +196,8 @@ struct ExplorerParams {
     a->Visit(MJSLAM_NVP(min_gain_m2));
     a->Visit(MJSLAM_NVP(gain_weight_per_m2));
     a->Visit(MJSLAM_NVP(view_distance_m));
+    a->Visit(MJSLAM_NVP(max_view_distance_m));
+    a->Visit(MJSLAM_NVP(face_frontier_deg));
     a->Visit(MJSLAM_NVP(min_frontier_cells));
     a->Visit(MJSLAM_NVP(goal_tolerance_m));
     a->Visit(MJSLAM_NVP(progress_timeout_s));

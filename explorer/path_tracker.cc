@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "common/angles.h"
 #include "common/check.h"
@@ -30,6 +31,9 @@ constexpr double kWheelLagS = 0.05;
 constexpr double kBodyReachM = 0.33;
 // Speed of the body's fastest point at which the safety margin is whole, m/s.
 constexpr double kFullMarginSpeedMps = 0.3;
+// A robot within a command's safety margin may make it when no point of the
+// predicted motion comes closer than this less than its clearance now, m.
+constexpr double kNoCloserM = 1e-4;
 
 }  // namespace
 
@@ -154,6 +158,28 @@ bool BodyTouches(const Pose2& X_WR, const std::vector<Eigen::Vector2d>& points_W
   return false;
 }
 
+double BodyClearanceM(const Pose2& X_WR, const std::vector<Eigen::Vector2d>& points_W,
+                      const ExplorerParams& params) {
+  const Pose2 X_RW = X_WR.Inverse();
+  const bool wheels = params.wheel_radius_m > 0.0;
+  double clearance = std::numeric_limits<double>::infinity();
+  for (const Eigen::Vector2d& p_W : points_W) {
+    const Eigen::Vector2d p_R = X_RW * p_W;
+    // The rectangle grown by m holds p when the larger of its distances
+    // outside the rectangle along x and along y is at most m.
+    const double outside_x = std::max({params.body_rear_x_m - p_R.x(),
+                                       p_R.x() - params.body_front_x_m, 0.0});
+    const double outside_y = std::max(std::abs(p_R.y()) - params.body_half_width_m, 0.0);
+    clearance = std::min(clearance, std::max(outside_x, outside_y));
+    if (wheels) {
+      const double to_wheel =
+          Eigen::Vector2d(p_R.x() - params.wheel_x_m, std::abs(p_R.y()) - params.wheel_y_m).norm();
+      clearance = std::min(clearance, std::max(0.0, to_wheel - params.wheel_radius_m));
+    }
+  }
+  return clearance;
+}
+
 namespace {
 
 // Whether the body touches an obstacle while `command` is held for `dt_s`
@@ -206,8 +232,13 @@ double SafetyMarginM(const Twist2& command, const ExplorerParams& params) {
 Twist2 SafetyFilter(const Twist2& command, const Pose2& X_WR,
                     const std::vector<Eigen::Vector2d>& obstacles_W,
                     const ExplorerParams& params, double a_m, double dt_s, bool* limited) {
-  // A robot already inside the slow margin may still move (away).
-  const bool inside = BodyTouches(X_WR, obstacles_W, params, params.safety_margin_slow_m);
+  // A robot already inside the slow margin may still move (away). One
+  // between the slow margin and a command's margin may make the motions that
+  // come no closer than it is: without that, every command but a stop touched
+  // at once, and a robot stopped with a wheel 0.025 m from a door's jamb
+  // stood there until no goal was left.
+  const double clearance = BodyClearanceM(X_WR, obstacles_W, params);
+  const bool inside = clearance <= params.safety_margin_slow_m;
   const Twist2 candidates[] = {command,
                                {0.5 * command.v_mps, command.w_radps},
                                {command.v_mps, 0.0},
@@ -216,7 +247,9 @@ Twist2 SafetyFilter(const Twist2& command, const Pose2& X_WR,
                                {0.0, 0.0}};
   if (limited != nullptr) *limited = false;
   for (const Twist2& candidate : candidates) {
-    const double margin = inside ? 0.0 : SafetyMarginM(candidate, params);
+    const double margin =
+        inside ? 0.0
+               : std::min(SafetyMarginM(candidate, params), clearance - kNoCloserM);
     if (!PredictedContact(candidate, X_WR, obstacles_W, params, a_m, dt_s, margin)) {
       if (limited != nullptr) {
         *limited = candidate.v_mps != command.v_mps || candidate.w_radps != command.w_radps;

@@ -66,12 +66,21 @@ double SafetyMarginM(const Twist2& command, const ExplorerParams& params);
 /// obstacle it tries, in order, half the speed, no turn, half the speed and
 /// no turn, turning in place, a full stop. When the body is already within
 /// the slow margin of an obstacle,
-/// only actual contact is checked, so the robot can still move away.
+/// only actual contact is checked, so the robot can still move away; when it
+/// is within a command's margin but not the slow one, the command may come no
+/// closer than the body is now (`BodyClearanceM`).
 /// `a_m` is the offset of h ahead of the axle; `limited` (optional) tells
 /// whether the command was changed.
 Twist2 SafetyFilter(const Twist2& command, const Pose2& X_WR,
                     const std::vector<Eigen::Vector2d>& obstacles_W,
                     const ExplorerParams& params, double a_m, double dt_s, bool* limited);
+
+/// The margin by which the body of the robot at `X_WR` clears the nearest
+/// of `points_W` (infinity for none): `BodyTouches(X_WR, points_W, params, m)`
+/// is true exactly when this is at most m (the rectangle's margin measured
+/// along its axes, the wheel discs' radially).
+double BodyClearanceM(const Pose2& X_WR, const std::vector<Eigen::Vector2d>& points_W,
+                      const ExplorerParams& params);
 
 /// Whether any of `points_W` lies inside the body rectangle of the robot at
 /// `X_WR`, grown by `margin_m`.

@@ -3,6 +3,7 @@
 
 #include <gtest/gtest.h>
 
+#include "common/angles.h"
 #include "explorer/explorer.h"
 #include "explorer/path_tracker.h"
 #include "tests/support/kinematic_sim.h"
@@ -170,6 +171,51 @@ TEST(SafetyFilterTest, CreepingThroughAStandardDoorKeepsASmallerMargin) {
   ExplorerParams fixed = params;
   fixed.safety_margin_slow_m = fixed.safety_margin_m;
   SafetyFilter({0.1, 0.0}, Pose2(), jambs, fixed, 0.2025, 0.1, &limited);
+  EXPECT_TRUE(limited);
+}
+
+TEST(SafetyFilterTest, BodyClearanceIsTheMarginAtWhichTheBodyTouches) {
+  ExplorerParams params;
+  const Pose2 X_WR(1.0, -2.0, 0.7);
+  // Points around the body (rectangle and wheel discs), from inside to 0.3 m out.
+  for (double x = -0.8; x <= 0.3; x += 0.037) {
+    for (double y = -0.6; y <= 0.6; y += 0.041) {
+      const std::vector<Eigen::Vector2d> point{X_WR * Eigen::Vector2d(x, y)};
+      const double clearance = BodyClearanceM(X_WR, point, params);
+      EXPECT_TRUE(BodyTouches(X_WR, point, params, clearance + 1e-9)) << x << " " << y;
+      if (clearance > 1e-9) {
+        EXPECT_FALSE(BodyTouches(X_WR, point, params, clearance - 1e-9)) << x << " " << y;
+      }
+    }
+  }
+  EXPECT_EQ(BodyClearanceM(X_WR, {}, params), std::numeric_limits<double>::infinity());
+}
+
+// Wedged at a door's jamb (floor_14x8_d080, seed 10, true pose at 88 s): a
+// wall 0.15 m thick below y = 2.9 from the jamb at x = 9.0 on, the robot at
+// (8.96, 3.246) heading 41 deg, its right wheel's disc 0.025 m from the jamb's
+// corner: inside the margin of every moving command (0.03 m and more), outside
+// the slow one (0.02 m). Every motion touched the margin at once, so the
+// safety layer stopped each recovery and the robot stood there until no goal
+// was left. A motion that comes no closer is allowed now; one toward the
+// jamb is still refused.
+TEST(SafetyFilterTest, ARobotWedgedAtAJambMayMoveAway) {
+  ExplorerParams params;
+  std::vector<Eigen::Vector2d> jamb;
+  for (double x = 9.0; x <= 10.0 + 1e-9; x += 0.01) jamb.emplace_back(x, 2.9);
+  for (double y = 2.75; y < 2.9; y += 0.01) jamb.emplace_back(9.0, y);
+  const Pose2 X_WR(8.96, 3.246, DegToRad(41.0));
+  const double clearance = BodyClearanceM(X_WR, jamb, params);
+  EXPECT_GT(clearance, params.safety_margin_slow_m);
+  EXPECT_LT(clearance, SafetyMarginM({0.1, 0.0}, params));
+  const double a_m = 0.2025;
+  bool limited = true;
+  // Turning clockwise swings the right wheel up, away from the corner.
+  const Twist2 away = SafetyFilter({0.0, -0.4}, X_WR, jamb, params, a_m, 0.1, &limited);
+  EXPECT_FALSE(limited);
+  EXPECT_EQ(away.w_radps, -0.4);
+  // Driving forward brings the right side nearer the corner.
+  SafetyFilter({0.1, 0.0}, X_WR, jamb, params, a_m, 0.1, &limited);
   EXPECT_TRUE(limited);
 }
 
