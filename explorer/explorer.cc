@@ -145,11 +145,11 @@ bool Explorer::Blacklisted(const Eigen::Vector2d& p_W, bool* failed, int* looks)
   bool near = false;
   if (failed != nullptr) *failed = false;
   if (looks != nullptr) *looks = 0;
-  for (size_t i = 0; i < blacklist_.size(); ++i) {
-    if ((blacklist_[i] - p_W).norm() < params_.blacklist_radius_m) {
+  for (const BlacklistEntry& entry : blacklist_) {
+    if ((entry.p_W - p_W).norm() < params_.blacklist_radius_m) {
       near = true;
-      if (failed != nullptr && blacklist_failed_[i]) *failed = true;
-      if (looks != nullptr && !blacklist_failed_[i] && blacklist_frontier_[i]) ++*looks;
+      if (failed != nullptr && entry.failed) *failed = true;
+      if (looks != nullptr && !entry.failed && entry.frontier) ++*looks;
     }
   }
   return near;
@@ -157,12 +157,8 @@ bool Explorer::Blacklisted(const Eigen::Vector2d& p_W, bool* failed, int* looks)
 
 void Explorer::DropGoal(bool blacklist, bool failed) {
   if (has_goal_ && blacklist) {
-    blacklist_.push_back(frontier_W_);
-    blacklist_.push_back(goal_W_);
-    blacklist_failed_.push_back(failed ? 1 : 0);
-    blacklist_failed_.push_back(failed ? 1 : 0);
-    blacklist_frontier_.push_back(1);
-    blacklist_frontier_.push_back(0);
+    blacklist_.push_back({frontier_W_, failed, true});
+    blacklist_.push_back({goal_W_, failed, false});
   }
   has_goal_ = false;
   backing_out_ = false;
@@ -220,12 +216,16 @@ bool Explorer::PlanToGoal(const NavigationMap& map, const Pose2& X_WR, double t_
   return true;
 }
 
-Twist2 Explorer::BackOut(const Pose2& X_WR, double t_s, double dt_s) {
+bool Explorer::HasTurningRoom(const Eigen::Vector2d& axle_W) {
   clearance_.Update(grid_);
+  const Eigen::Vector2i cell = grid_.CellOf(axle_W);
+  return grid_.Contains(cell.x(), cell.y()) &&
+         clearance_.Clearance(cell.x(), cell.y()) >= params_.turn_clearance_m;
+}
+
+Twist2 Explorer::BackOut(const Pose2& X_WR, double t_s, double dt_s) {
   const Eigen::Vector2d axle = AxleOf(X_WR);
-  const Eigen::Vector2i cell = grid_.CellOf(axle);
-  const bool room = grid_.Contains(cell.x(), cell.y()) &&
-                    clearance_.Clearance(cell.x(), cell.y()) >= params_.turn_clearance_m;
+  const bool room = HasTurningRoom(axle);
   if (room || (axle - back_out_from_W_).norm() >= kMaxBackOutM || blocked_s_ > 0.0) {
     backing_out_ = false;
     back_out_held_ = !room && blocked_s_ > 0.0;
@@ -368,10 +368,7 @@ void Explorer::ArriveAtGoal(const Pose2& X_WR, double t_s) {
   const Eigen::Vector2d axle = AxleOf(X_WR);
   const Eigen::Vector2d to = frontier_W_ - axle;
   const double error = WrapAngle(std::atan2(to.y(), to.x()) - X_WR.theta);
-  clearance_.Update(grid_);
-  const Eigen::Vector2i cell = grid_.CellOf(axle);
-  const bool room = grid_.Contains(cell.x(), cell.y()) &&
-                    clearance_.Clearance(cell.x(), cell.y()) >= params_.turn_clearance_m;
+  const bool room = HasTurningRoom(axle);
   if (std::abs(error) > DegToRad(params_.face_frontier_deg) && room) {
     facing_ = true;
     facing_since_s_ = t_s;

@@ -1,6 +1,5 @@
 #pragma once
 
-#include <cstdint>
 #include <optional>
 #include <string>
 #include <vector>
@@ -92,8 +91,14 @@ class Explorer {
 
   /// The occupancy grid built so far.
   const OccupancyGrid& grid() const { return grid_; }
-  /// Frontier points and goals that failed or were reached, in W.
-  const std::vector<Eigen::Vector2d>& blacklist() const { return blacklist_; }
+  /// A frontier point or goal cell that failed or was reached, in W.
+  struct BlacklistEntry {
+    Eigen::Vector2d p_W;
+    bool failed = false;    ///< the goal failed (otherwise it was reached)
+    bool frontier = false;  ///< a frontier point (otherwise a goal cell)
+  };
+  /// Frontier points and goals that failed or were reached.
+  const std::vector<BlacklistEntry>& blacklist() const { return blacklist_; }
   bool finished() const { return finished_; }
   const std::string& finish_reason() const { return finish_reason_; }
 
@@ -157,14 +162,18 @@ class Explorer {
   // which the laser, facing the point, sees it), and that cell's centre in
   // `viewpoint_W` (untouched when there is none: the cost is infinite).
   // `far`: cells near a blacklisted point are no viewpoints (the robot
-  // looked from there), and the laser must look at the point along the way
-  // into the unknown beyond it (within kFarLookDeg of UnknownDirection: a
-  // strip too narrow to turn in is seen along its length).
+  // looked from there), and each radian between the laser's line of sight
+  // and the way into the unknown beyond the point (UnknownDirection) costs
+  // kFarLookCostPerRad, so that a strip too narrow to turn in is seen along
+  // its length.
   double BestViewpoint(const NavigationMap& map, const Eigen::Vector2d& p_W, double radius_m,
                        bool far, Eigen::Vector2d* viewpoint_W) const;
   // Whether the laser, with the axle at `axle_W` and the robot facing
   // `p_W`, sees `p_W` (no occupied cell between them, within range).
   bool LaserSees(const Eigen::Vector2d& axle_W, const Eigen::Vector2d& p_W) const;
+  // Whether the axle at `axle_W` has turn_clearance_m (the clearance
+  // brought up to date first).
+  bool HasTurningRoom(const Eigen::Vector2d& axle_W);
   // Starts the turn that faces the goal's frontier point at a goal reached
   // (when it is face_frontier_deg off and the axle has turning room);
   // otherwise drops the goal as reached.
@@ -204,11 +213,7 @@ class Explorer {
   std::vector<Eigen::Vector2d> local_points_;
   std::vector<Eigen::Vector2d> scan_points_W_;
   std::vector<Eigen::Vector2d> frontier_points_;
-  std::vector<Eigen::Vector2d> blacklist_;
-  // Per blacklist entry: 1 when the goal failed, 0 when it was reached.
-  std::vector<std::uint8_t> blacklist_failed_;
-  // Per blacklist entry: 1 for a frontier point, 0 for a goal cell.
-  std::vector<std::uint8_t> blacklist_frontier_;
+  std::vector<BlacklistEntry> blacklist_;
 
   bool has_goal_ = false;
   // The frontier point the goal serves, and the cell h drives to.
