@@ -127,9 +127,80 @@ void FreeSlot(mjModel* local, int slot) {
   std::copy_n(identity, 4, local->geom_quat + 4 * slot);
 }
 
-// The local model's world: the <size> of the full model and `slots` free
-// geom slots on the world body.
-std::string SlotWorldXml(const mjModel& full, int slots) {
+// MuJoCo 2.2.2's contact filter (mj_contactFilter, as mj_collideGeoms calls
+// it for a geom pair it found itself): whether geoms g1 and g2 of `m` never
+// make contacts with each other.
+bool Filtered(const mjModel& m, int g1, int g2) {
+  if (!(m.geom_contype[g1] & m.geom_conaffinity[g2]) &&
+      !(m.geom_contype[g2] & m.geom_conaffinity[g1])) {
+    return true;
+  }
+  const int weld1 = m.body_weldid[m.geom_bodyid[g1]];
+  const int weld2 = m.body_weldid[m.geom_bodyid[g2]];
+  if (weld1 == weld2) return true;
+  const bool filter_parent = !(m.opt.disableflags & mjDSBL_FILTERPARENT) && weld1 && weld2;
+  return filter_parent && (weld1 == m.body_weldid[m.body_parentid[weld2]] ||
+                           weld2 == m.body_weldid[m.body_parentid[weld1]]);
+}
+
+// Makes pair `pair` of `m` the geom pair (g1, g2) with the contact
+// parameters MuJoCo 2.2.2's mj_collideGeoms gives a pair it finds itself
+// (priority or maximum for condim and friction, the solmix mixture of solref
+// and solimp, the largest margin and gap): the same operations on the same
+// numbers in the same order (the geoms ordered by type first, as there), so
+// the contacts of the pair are the same, bit for bit.
+void SetPairAsFound(mjModel* m, int pair, int g1, int g2) {
+  m->pair_geom1[pair] = g1;
+  m->pair_geom2[pair] = g2;
+  if (m->geom_type[g1] > m->geom_type[g2]) std::swap(g1, g2);
+  mjtNum* friction = m->pair_friction + 5 * pair;
+  mjtNum* solref = m->pair_solref + mjNREF * pair;
+  mjtNum* solimp = m->pair_solimp + mjNIMP * pair;
+  m->pair_margin[pair] = mju_max(m->geom_margin[g1], m->geom_margin[g2]);
+  m->pair_gap[pair] = mju_max(m->geom_gap[g1], m->geom_gap[g2]);
+  if (m->geom_priority[g1] != m->geom_priority[g2]) {
+    const int gp = m->geom_priority[g1] > m->geom_priority[g2] ? g1 : g2;
+    m->pair_dim[pair] = m->geom_condim[gp];
+    for (int i = 0; i < 3; ++i) friction[2 * i] = m->geom_friction[3 * gp + i];
+    mju_copy(solref, m->geom_solref + mjNREF * gp, mjNREF);
+    mju_copy(solimp, m->geom_solimp + mjNIMP * gp, mjNIMP);
+  } else {
+    m->pair_dim[pair] = std::max(m->geom_condim[g1], m->geom_condim[g2]);
+    for (int i = 0; i < 3; ++i) {
+      friction[2 * i] = mju_max(m->geom_friction[3 * g1 + i], m->geom_friction[3 * g2 + i]);
+    }
+    const mjtNum solmix1 = m->geom_solmix[g1];
+    const mjtNum solmix2 = m->geom_solmix[g2];
+    mjtNum mix;
+    if (solmix1 >= mjMINVAL && solmix2 >= mjMINVAL) {
+      mix = solmix1 / (solmix1 + solmix2);
+    } else if (solmix1 < mjMINVAL && solmix2 < mjMINVAL) {
+      mix = 0.5;
+    } else if (solmix1 < mjMINVAL) {
+      mix = 0.0;
+    } else {
+      mix = 1.0;
+    }
+    if (m->geom_solref[mjNREF * g1] > 0 && m->geom_solref[mjNREF * g2] > 0) {
+      for (int i = 0; i < mjNREF; ++i) {
+        solref[i] = mix * m->geom_solref[mjNREF * g1 + i] + (1 - mix) * m->geom_solref[mjNREF * g2 + i];
+      }
+    } else {
+      for (int i = 0; i < mjNREF; ++i) {
+        solref[i] = mju_min(m->geom_solref[mjNREF * g1 + i], m->geom_solref[mjNREF * g2 + i]);
+      }
+    }
+    mju_scl(solimp, m->geom_solimp + mjNIMP * g1, mix, mjNIMP);
+    mju_addToScl(solimp, m->geom_solimp + mjNIMP * g2, 1 - mix, mjNIMP);
+  }
+  friction[1] = friction[0];
+  friction[3] = friction[4];
+}
+
+// The local model's world: the <size> of the full model, `slots` free geom
+// slots on the world body and `pairs` placeholder contact pairs (rewritten
+// at every refresh, see ContactPairs).
+std::string SlotWorldXml(const mjModel& full, int slots, int pairs) {
   std::ostringstream xml;
   xml << "<mujoco model=\"mjslam_local_physics\">\n  <size njmax=\"" << full.njmax
       << "\" nconmax=\"" << full.nconmax << "\" nstack=\"" << full.nstack << "\" nuserdata=\""
@@ -139,7 +210,16 @@ std::string SlotWorldXml(const mjModel& full, int slots) {
         << "\" type=\"sphere\" size=\"0.001\" contype=\"0\" conaffinity=\"0\" group=\"4\" "
            "rgba=\"0 0 0 0\"/>\n";
   }
-  xml << "  </worldbody>\n</mujoco>\n";
+  xml << "  </worldbody>\n";
+  if (pairs > 0) {
+    xml << "  <contact>\n";
+    for (int pair = 0; pair < pairs; ++pair) {
+      xml << "    <pair geom1=\"mjslam_slot_0\" geom2=\"mjslam_slot_" << std::min(1, slots - 1)
+          << "\"/>\n";
+    }
+    xml << "  </contact>\n";
+  }
+  xml << "</mujoco>\n";
   return xml.str();
 }
 
@@ -169,9 +249,17 @@ LocalPhysics::LocalPhysics(const Scene& scene, const mjModel& full, const RobotI
     }
   }
   const int slots = static_cast<int>(planes_.size()) + geoms.MaxContactCandidates();
-  model_ = LoadRobotWithWorldXml(scene.robot_model_path(), SlotWorldXml(full, slots),
+  int robot_colliding = 0;
+  for (int geom = 0; geom < full.ngeom; ++geom) {
+    if (IsRobotGeom(full, full_ids, geom) && Collides(full, geom)) ++robot_colliding;
+  }
+  // Enough pairs for every slot with every colliding robot geom, and for
+  // every two colliding robot geoms.
+  const int pairs = slots * robot_colliding + robot_colliding * (robot_colliding - 1) / 2;
+  model_ = LoadRobotWithWorldXml(scene.robot_model_path(), SlotWorldXml(full, slots, pairs),
                                  "the local physics model of " + scene.Description());
   ids_ = FindRobotIndices(*model_, "robot model '" + scene.robot_model_path() + "'");
+  MJSLAM_CHECK(model_->npair == pairs);
   model_->opt = full.opt;
   model_->stat = full.stat;
   const std::string difference = FirstRobotDifference(full, full_ids, *model_, ids_);
@@ -185,7 +273,69 @@ LocalPhysics::LocalPhysics(const Scene& scene, const mjModel& full, const RobotI
   robot_geom_offset_ = FindRobotRows(full, full_ids).geom - first_local_robot_geom_;
   slot_geom_.assign(slots, -1);
   for (int slot = 0; slot < slots; ++slot) FreeSlot(model_.get(), slot);
+  pair_capacity_ = pairs;
+  ListRobotPairs();
+  UpdatePairs();
   data_ = MakeData(*model_, "starting the local physics model");
+}
+
+void LocalPhysics::ListRobotPairs() {
+  const mjModel& m = *model_;
+  // MuJoCo's broadphase would not skip a pair the explicit list collides:
+  // its boxes hold each geom's bounding sphere (rbound and margin), so it
+  // keeps every pair whose spheres meet; a geom without a bounding sphere
+  // (rbound 0) has no such guarantee, nor does a contact filter callback or
+  // a model that does not find its pairs itself.
+  lists_pairs_ = m.opt.collision != mjCOL_PAIR && mjcb_contactfilter == nullptr;
+  robot_geoms_.assign(m.nbody, {});
+  for (int body = 1; body < m.nbody; ++body) {
+    for (int geom = m.body_geomadr[body]; geom < m.body_geomadr[body] + m.body_geomnum[body];
+         ++geom) {
+      if (!Collides(m, geom)) continue;
+      robot_geoms_[body].push_back(geom);
+      if (m.geom_rbound[geom] <= 0) lists_pairs_ = false;
+    }
+  }
+  // Robot with robot, in the broadphase's order (body pairs by id, then
+  // the first body's geoms, then the second's).
+  robot_pairs_.clear();
+  for (int body1 = 1; body1 < m.nbody; ++body1) {
+    for (int body2 = body1 + 1; body2 < m.nbody; ++body2) {
+      for (int geom1 : robot_geoms_[body1]) {
+        for (int geom2 : robot_geoms_[body2]) {
+          if (!Filtered(m, geom1, geom2)) robot_pairs_.emplace_back(geom1, geom2);
+        }
+      }
+    }
+  }
+  if (lists_pairs_) model_->opt.collision = mjCOL_PAIR;
+}
+
+void LocalPhysics::UpdatePairs() {
+  if (!lists_pairs_) {
+    model_->npair = 0;
+    return;
+  }
+  // The order of MuJoCo's own search: the world body with each robot body
+  // (by id), the world's geoms (the slots) before the robot body's; then the
+  // robot's body pairs.
+  mjModel* m = model_.get();
+  int pair = 0;
+  for (int body = 1; body < m->nbody; ++body) {
+    for (int slot = 0; slot < static_cast<int>(slot_geom_.size()); ++slot) {
+      if (slot_geom_[slot] < 0) continue;
+      for (int geom : robot_geoms_[body]) {
+        if (Filtered(*m, slot, geom)) continue;
+        MJSLAM_CHECK(pair < pair_capacity_);
+        SetPairAsFound(m, pair++, slot, geom);
+      }
+    }
+  }
+  for (const auto& [geom1, geom2] : robot_pairs_) {
+    MJSLAM_CHECK(pair < pair_capacity_);
+    SetPairAsFound(m, pair++, geom1, geom2);
+  }
+  m->npair = pair;
 }
 
 void LocalPhysics::Refresh(const mjModel& full, const LocalGeoms& geoms, const mjtNum* p_root,
@@ -197,6 +347,7 @@ void LocalPhysics::Refresh(const mjModel& full, const LocalGeoms& geoms, const m
                                 [&](int geom) { candidates_.push_back(geom); });
   std::sort(candidates_.begin(), candidates_.end());
   MJSLAM_CHECK(candidates_.size() <= slot_geom_.size());
+  bool changed = false;
   for (std::size_t slot = 0; slot < slot_geom_.size(); ++slot) {
     const int geom = slot < candidates_.size() ? candidates_[slot] : -1;
     if (slot_geom_[slot] == geom) continue;
@@ -206,7 +357,9 @@ void LocalPhysics::Refresh(const mjModel& full, const LocalGeoms& geoms, const m
       FreeSlot(model_.get(), static_cast<int>(slot));
     }
     slot_geom_[slot] = geom;
+    changed = true;
   }
+  if (changed) UpdatePairs();
 }
 
 int LocalPhysics::FullGeom(int local_geom) const {

@@ -6,6 +6,7 @@
 
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <mujoco/mujoco.h>
@@ -82,6 +83,21 @@ class LocalPhysics {
   int first_local_robot_geom_ = 0;
   ContactRefresh refresh_;
   std::vector<int> candidates_;
+  // The geom pairs MuJoCo's broadphase would find, listed as the model's
+  // explicit pairs (opt.collision = mjCOL_PAIR): the same contacts in the
+  // same order without the broadphase (sim/README.md, "The local physics
+  // model"). False: MuJoCo finds them itself.
+  bool lists_pairs_ = false;
+  int pair_capacity_ = 0;
+  // Each robot body's colliding geoms (index: local body id).
+  std::vector<std::vector<int>> robot_geoms_;
+  // The robot's geom pairs that MuJoCo's contact filter lets through.
+  std::vector<std::pair<int, int>> robot_pairs_;
+
+  void ListRobotPairs();
+  // Rewrites the explicit pairs for the present slots (npair: the pairs in
+  // use; the model holds pair_capacity_).
+  void UpdatePairs();
 };
 
 /// Copies the state of `from` into `to` (models of the same robot: equal

@@ -11,7 +11,15 @@
 
 #include <gtest/gtest.h>
 
+#include <cstddef>
+#include <cstring>
+
+#include <mujoco/mujoco.h>
+
+#include "sim/local_geoms.h"
+#include "sim/local_physics.h"
 #include "sim/scene.h"
+#include "sim/scene_model.h"
 #include "sim/simulator.h"
 #include "tests/sim/sim_test_util.h"
 
@@ -110,6 +118,56 @@ TEST_F(LocalPhysicsTest, SwitchingToTheFullSceneAndBackChangesNothing) {
   }
   // It did run into the wall.
   EXPECT_GT(contacts, 0);
+}
+
+// The local model lists the geom pairs MuJoCo's broadphase would find as
+// explicit pairs (opt.collision = mjCOL_PAIR), and they give the contacts
+// MuJoCo finds itself in the same model (opt.collision = mjCOL_ALL, no
+// pairs), byte for byte, with the robot placed on a 0.37 m grid over the
+// corridor loop (in and through its walls too).
+TEST_F(LocalPhysicsTest, TheListedPairsGiveTheContactsMujocoFindsItself) {
+  const Scene scene(WorldPath("corridor_loop.xml"), RobotModelPath());
+  const mjModel& full = internal::SceneAccess::Model(scene);
+  const internal::RobotIndices& full_ids = internal::SceneAccess::Robot(scene);
+  const internal::DataPtr full_data = internal::MakeData(full, "test");
+  mj_forward(&full, full_data.get());
+  mjtByte groups[mjNGROUP] = {1, 1, 1, 1, 1, 0};
+  const internal::LocalGeoms geoms(full, *full_data, full_ids, groups);
+  internal::LocalPhysics local(scene, full, full_ids, geoms);
+  ASSERT_EQ(local.problem(), "");
+  mjModel* m = local.model();
+  mjData* d = local.data();
+  ASSERT_EQ(m->opt.collision, mjCOL_PAIR);
+  int compared = 0;
+  int wall_contacts = 0;
+  for (double x = -15.0; x <= 15.0; x += 0.37) {
+    for (double y = -15.0; y <= 15.0; y += 0.37) {
+      mjtNum* root = d->qpos + local.ids().root_qposadr;
+      root[0] = x;
+      root[1] = y;
+      local.Refresh(full, geoms, root, /*force=*/true);
+      mj_forward(m, d);
+      const std::vector<mjContact> listed(d->contact, d->contact + d->ncon);
+      const int npair = m->npair;
+      m->opt.collision = mjCOL_ALL;
+      m->npair = 0;
+      mj_forward(m, d);
+      m->opt.collision = mjCOL_PAIR;
+      m->npair = npair;
+      ASSERT_EQ(d->ncon, static_cast<int>(listed.size())) << x << ", " << y;
+      for (int i = 0; i < d->ncon; ++i) {
+        // Every field up to the last (the struct's padding left out).
+        ASSERT_EQ(std::memcmp(&listed[i], &d->contact[i],
+                              offsetof(mjContact, efc_address) + sizeof(int)),
+                  0)
+            << x << ", " << y << ", contact " << i;
+        wall_contacts += m->geom_type[d->contact[i].geom1] != mjGEOM_PLANE;
+      }
+      compared += d->ncon;
+    }
+  }
+  EXPECT_GT(compared, 3000);
+  EXPECT_GT(wall_contacts, 100);
 }
 
 TEST_F(LocalPhysicsTest, WorldsWithoutALocalModelSayWhyAndStillRun) {
