@@ -24,8 +24,9 @@ namespace mjslam::sim::internal {
 /// its contact radius), in the full model's geom order; the other slots do
 /// not collide. MuJoCo then finds the same contacts in the same order as in
 /// the full model and the physics is the same, bit for bit, while every
-/// step's cost (kinematics, broadphase, the pair loop) depends on the slots
-/// only, not on the size of the world. The robot part of the model is
+/// step's cost (kinematics, the pair loop) depends on the slots only, not on
+/// the size of the world. MuJoCo's broadphase is replaced by the list of the
+/// geom pairs it would find (explicit pairs, rewritten at each refresh). The robot part of the model is
 /// compiled from the same robot file and checked against the full model's
 /// (every floating-point array of its bodies, geoms, sites, joints, dofs and
 /// actuators); options and statistics are copied from the full model.
