@@ -183,7 +183,8 @@ void SetPairAsFound(mjModel* m, int pair, int g1, int g2) {
     }
     if (m->geom_solref[mjNREF * g1] > 0 && m->geom_solref[mjNREF * g2] > 0) {
       for (int i = 0; i < mjNREF; ++i) {
-        solref[i] = mix * m->geom_solref[mjNREF * g1 + i] + (1 - mix) * m->geom_solref[mjNREF * g2 + i];
+        solref[i] = mix * m->geom_solref[mjNREF * g1 + i] +
+                    (1 - mix) * m->geom_solref[mjNREF * g2 + i];
       }
     } else {
       for (int i = 0; i < mjNREF; ++i) {
@@ -254,8 +255,10 @@ LocalPhysics::LocalPhysics(const Scene& scene, const mjModel& full, const RobotI
     if (IsRobotGeom(full, full_ids, geom) && Collides(full, geom)) ++robot_colliding;
   }
   // Enough pairs for every slot with every colliding robot geom, and for
-  // every two colliding robot geoms.
-  const int pairs = slots * robot_colliding + robot_colliding * (robot_colliding - 1) / 2;
+  // every two colliding robot geoms (the placeholders name slots: none
+  // without slots, and then MuJoCo finds the pairs itself).
+  const int pairs =
+      slots > 0 ? slots * robot_colliding + robot_colliding * (robot_colliding - 1) / 2 : 0;
   model_ = LoadRobotWithWorldXml(scene.robot_model_path(), SlotWorldXml(full, slots, pairs),
                                  "the local physics model of " + scene.Description());
   ids_ = FindRobotIndices(*model_, "robot model '" + scene.robot_model_path() + "'");
@@ -286,7 +289,8 @@ void LocalPhysics::ListRobotPairs() {
   // keeps every pair whose spheres meet; a geom without a bounding sphere
   // (rbound 0) has no such guarantee, nor does a contact filter callback or
   // a model that does not find its pairs itself.
-  lists_pairs_ = m.opt.collision != mjCOL_PAIR && mjcb_contactfilter == nullptr;
+  lists_pairs_ =
+      m.opt.collision != mjCOL_PAIR && mjcb_contactfilter == nullptr && pair_capacity_ > 0;
   robot_geoms_.assign(m.nbody, {});
   for (int body = 1; body < m.nbody; ++body) {
     for (int geom = m.body_geomadr[body]; geom < m.body_geomadr[body] + m.body_geomnum[body];

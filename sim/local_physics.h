@@ -26,10 +26,11 @@ namespace mjslam::sim::internal {
 /// the full model and the physics is the same, bit for bit, while every
 /// step's cost (kinematics, the pair loop) depends on the slots only, not on
 /// the size of the world. MuJoCo's broadphase is replaced by the list of the
-/// geom pairs it would find (explicit pairs, rewritten at each refresh). The robot part of the model is
-/// compiled from the same robot file and checked against the full model's
-/// (every floating-point array of its bodies, geoms, sites, joints, dofs and
-/// actuators); options and statistics are copied from the full model.
+/// geom pairs it would find (explicit pairs, rewritten at each refresh).
+/// The robot part of the model is compiled from the same robot file and
+/// checked against the full model's (every floating-point array of its
+/// bodies, geoms, sites, joints, dofs and actuators); options and statistics
+/// are copied from the full model (but opt.collision, see lists_pairs_).
 class LocalPhysics {
  public:
   /// Why the full model `full` cannot be replaced by a local model (empty
