@@ -53,9 +53,10 @@ constexpr double kRecoverySpeedMps = 0.1;
 constexpr double kRecoveryTurnRadps = 0.4;
 // The first cost bound of the search for a goal, metres (then doubled).
 constexpr double kFirstSearchCostM = 4.0;
-// A robot that backs out of a narrow place stops after this distance even
-// without turning room, metres.
-constexpr double kMaxBackOutM = 1.0;
+// A back-out drives the planned path backward to the first point where the
+// axle has turning room and this much further, so that the tracker's end
+// (within goal_tolerance_m) lies past that point, metres.
+constexpr double kBackOutPastRoomM = 0.3;
 // A path that starts with a turn in place of more than this reverses the
 // robot's direction, degrees.
 constexpr double kReverseDeg = 90.0;
@@ -113,7 +114,8 @@ Explorer::Explorer(const ExplorerParams& params, double a_m)
       a_m_(a_m),
       grid_(GridSettings(params)),
       clearance_(ClearanceCapM(params)),
-      tracker_(params, a_m) {
+      tracker_(params, a_m),
+      reverse_tracker_(params, a_m) {
   if (params_.initial_turn_deg <= 0.0) phase_ = Phase::kExploring;
 }
 
@@ -165,6 +167,7 @@ void Explorer::DropGoal(bool blacklist, bool failed) {
   back_out_held_ = false;
   facing_ = false;
   tracker_.Clear();
+  reverse_tracker_.Clear();
   ++log_version_;
 }
 
@@ -206,11 +209,12 @@ bool Explorer::PlanToGoal(const NavigationMap& map, const Pose2& X_WR, double t_
   }
   Path path = PathOfPointH(axle_path, a_m_, X_WR.theta);
   // A path that reverses the robot's direction from a place where it cannot
-  // turn (a door, a narrow strip): back out straight first, the way it came.
+  // turn (a door, a narrow strip): drive its first part backward, the way
+  // the robot came, to where the axle has room to turn.
   const double turn = std::abs(WrapAngle(path.front().heading_rad - X_WR.theta));
   backing_out_ = path.front().turn_in_place && turn > DegToRad(kReverseDeg) &&
                  map.ClearanceAt(AxleOf(X_WR)) < params_.turn_clearance_m && !back_out_held_;
-  if (backing_out_) back_out_from_W_ = AxleOf(X_WR);
+  if (backing_out_) StartBackOut(map, axle_path, X_WR, t_s);
   tracker_.SetPath(std::move(path));
   ++log_version_;
   return true;
@@ -223,20 +227,68 @@ bool Explorer::HasTurningRoom(const Eigen::Vector2d& axle_W) {
          clearance_.Clearance(cell.x(), cell.y()) >= params_.turn_clearance_m;
 }
 
+void Explorer::StartBackOut(const NavigationMap& map, const Path& axle_path, const Pose2& X_WR,
+                            double t_s) {
+  // The axle path's first part, to the first point with turning room (and
+  // kBackOutPastRoomM on), at no more than narrow_speed_mps: the laser does
+  // not see behind the robot. The robot driving backward is a robot facing
+  // the other way driving forward (same axle, heading + pi, speed negated):
+  // its point h lies a_m behind the axle, and a PathTracker follows the
+  // path of that point.
+  Path reverse;
+  double room_s = std::numeric_limits<double>::infinity();
+  for (const PathPoint& point : axle_path) {
+    if (point.s_m > room_s + kBackOutPastRoomM) break;
+    reverse.push_back(point);
+    if (!std::isfinite(room_s) && map.ClearanceAt(point.p_W) >= params_.turn_clearance_m) {
+      room_s = point.s_m;
+    }
+  }
+  for (PathPoint& point : reverse) {
+    point.speed_mps = std::min(point.speed_mps, params_.narrow_speed_mps);
+  }
+  reverse.front().turn_in_place = false;
+  reverse.front().speed_mps = params_.narrow_speed_mps;
+  reverse.back().speed_mps = 0.0;
+  const Pose2 X_WF = FacingBack(X_WR);
+  reverse_tracker_.SetPath(PathOfPointH(reverse, a_m_, X_WF.theta));
+  back_out_best_s_ = 0.0;
+  back_out_progress_t_s_ = t_s;
+}
+
+Pose2 Explorer::FacingBack(const Pose2& X_WR) const {
+  const Eigen::Vector2d h = X_WR.translation() -
+                            2.0 * a_m_ * Eigen::Vector2d(std::cos(X_WR.theta), std::sin(X_WR.theta));
+  return Pose2(h.x(), h.y(), WrapAngle(X_WR.theta + kPi));
+}
+
 Twist2 Explorer::BackOut(const Pose2& X_WR, double t_s, double dt_s) {
-  const Eigen::Vector2d axle = AxleOf(X_WR);
-  const bool room = HasTurningRoom(axle);
-  if (room || (axle - back_out_from_W_).norm() >= kMaxBackOutM || blocked_s_ > 0.0) {
+  const bool room = HasTurningRoom(AxleOf(X_WR));
+  // Progress along the path backed: as a goal's, progress_min_m within
+  // progress_timeout_s.
+  const Path& reverse = reverse_tracker_.path();
+  const double backed_s = reverse.empty() ? 0.0 : reverse[reverse_tracker_.index()].s_m;
+  if (backed_s >= back_out_best_s_ + params_.progress_min_m) {
+    back_out_best_s_ = backed_s;
+    back_out_progress_t_s_ = t_s;
+  }
+  const bool stalled = t_s - back_out_progress_t_s_ > params_.progress_timeout_s;
+  if (room || reverse_tracker_.done() || blocked_s_ > 0.0 || stalled) {
     backing_out_ = false;
-    back_out_held_ = !room && blocked_s_ > 0.0;
+    // Ended without turning room: no new back-out for this goal (the
+    // recovery and the goal's clocks take over), or the two could alternate.
+    back_out_held_ = !room;
     // Backing out to turning room is a manoeuvre, not a lack of progress.
     if (room) progress_t_s_ = t_s;
+    reverse_tracker_.Clear();
     Replan(X_WR, t_s);
     return tracker_.last_command();
   }
-  const Twist2 target{-params_.narrow_speed_mps, 0.0};
-  return RateLimit(tracker_.last_command(), target, params_.max_linear_accel_mps2 * dt_s,
-                   params_.max_angular_accel_radps2 * dt_s);
+  // The tracker of the robot facing back, its last command mirrored.
+  const Twist2 last = tracker_.last_command();
+  reverse_tracker_.set_last_command(Twist2{-last.v_mps, last.w_radps});
+  const Twist2 mirrored = reverse_tracker_.Command(FacingBack(X_WR), dt_s);
+  return Twist2{-mirrored.v_mps, mirrored.w_radps};
 }
 
 std::vector<Explorer::Candidate> Explorer::ScoreFrontiers(

@@ -185,10 +185,18 @@ class Explorer {
   // back-out when the path reverses the robot's direction (a turn in place
   // of more than 90 deg first) where the axle lacks turn_clearance_m.
   bool PlanToGoal(const NavigationMap& map, const Pose2& X_WR, double t_s);
-  // One step of backing out straight (at narrow_speed_mps) until the axle
-  // has turn_clearance_m, has backed 1 m, or the safety layer holds it; then
-  // replans and returns the last command.
+  // Starts backing out along `axle_path` (the plan from the axle): its
+  // first part, to where the axle has turn_clearance_m, driven backward.
+  void StartBackOut(const NavigationMap& map, const Path& axle_path, const Pose2& X_WR,
+                    double t_s);
+  // One step of backing out until the axle has turn_clearance_m, the part
+  // is driven, the safety layer holds the robot, or it has made no progress
+  // (progress_min_m along the part within progress_timeout_s); then replans
+  // and returns the last command.
   Twist2 BackOut(const Pose2& X_WR, double t_s, double dt_s);
+  // The robot driving backward seen as one facing back and driving forward:
+  // the pose of its point h (a_m behind the axle), heading + pi.
+  Pose2 FacingBack(const Pose2& X_WR) const;
   // Drops the current goal; blacklists it when `blacklist`, as failed when
   // `failed` (otherwise as reached).
   void DropGoal(bool blacklist, bool failed = true);
@@ -233,10 +241,13 @@ class Explorer {
   // Index of the escape motion of the current recovery, or -1.
   int recovery_escape_ = -1;
 
-  // Backing out of a narrow place before a path that reverses direction,
-  // and where the axle was when it began.
+  // Backing out of a narrow place before a path that reverses direction:
+  // the tracker of the part driven backward (the path of the point a_m
+  // behind the axle), the arc length backed at the last progress, and when.
   bool backing_out_ = false;
-  Eigen::Vector2d back_out_from_W_ = Eigen::Vector2d::Zero();
+  PathTracker reverse_tracker_;
+  double back_out_best_s_ = 0.0;
+  double back_out_progress_t_s_ = 0.0;
   // The safety layer held the last back-out for the current goal: no new
   // one (the recovery takes over), or the two would alternate for ever.
   bool back_out_held_ = false;

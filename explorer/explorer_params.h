@@ -67,7 +67,7 @@ struct ExplorerParams {
   /// Clearance of the axle needed to turn in place (the rear corners reach
   /// 0.328 m from it; with the slow safety margin and half a cell, 0.40),
   /// metres: goals (viewpoints) need it; a robot without it that must
-  /// reverse its direction backs out straight instead of turning. A value
+  /// reverse its direction drives its path backward to where it has it. A value
   /// below `clearance_m` is met wherever a path may go.
   double turn_clearance_m = 0.40;
   /// Around the robot's start of a plan, cells with less clearance are

@@ -29,6 +29,14 @@ constexpr double kNarrowMarginM = 0.15;
 // A path whose first leg is narrow starts with a turn in place when it
 // leaves more than this off the heading, degrees.
 constexpr double kAlignBeforeNarrowDeg = 10.0;
+// Vertices of a path closer than this to its start are dropped (the path
+// starts at the first one farther away), metres: the tracker takes a
+// stop-and-turn point as reached once h is within 0.1 m of it, which a
+// robot facing a first leg of a cell or two is by turning alone, so it
+// turned there without the axle having moved; in front of a door, with each
+// replan starting the same first leg again, that was a robot turning left
+// and right for good. With 0.2 m the axle drives at least 0.1 m first.
+constexpr double kMinFirstLegM = 0.2;
 
 // Whether the segment [a, b] passes a narrow place (sampled every half cell).
 bool LegIsNarrow(const NavigationMap& map, const ExplorerParams& params,
@@ -409,6 +417,12 @@ Path PlanPath(const NavigationMap& map, const ExplorerParams& params,
   // Drop a degenerate first leg.
   if (vertices.size() > 2 && (vertices[1] - vertices[0]).norm() < 1e-9) {
     vertices.erase(vertices.begin() + 1);
+  }
+  // Start at the first vertex at least kMinFirstLegM from the start (the
+  // tracker steers h there when it is not reached yet).
+  const Eigen::Vector2d start = vertices.front();
+  while (vertices.size() > 2 && (vertices[1] - start).norm() < kMinFirstLegM) {
+    vertices.erase(vertices.begin());
   }
   if ((vertices.back() - vertices.front()).norm() < 1e-9) {
     PathPoint only;

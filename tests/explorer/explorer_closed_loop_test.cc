@@ -209,6 +209,70 @@ TEST(ExplorerClosedLoopTest, SeesADeadEndStripTooNarrowToTurnIn) {
   }
 }
 
+// A hall of 4 x 4 m with a dead-end strip 0.65 m wide and 4 m long leaving
+// the middle of its east wall (y in [1.675, 2.325], x in [4, 8]): the axle
+// cannot turn anywhere in the strip.
+std::vector<Wall> HallWithMiddleStrip() {
+  return {
+      {{0.0, 0.0}, {4.0, 0.0}},     {{4.0, 0.0}, {4.0, 1.675}},   {{4.0, 1.675}, {8.0, 1.675}},
+      {{8.0, 1.675}, {8.0, 2.325}}, {{4.0, 2.325}, {8.0, 2.325}}, {{4.0, 2.325}, {4.0, 4.0}},
+      {{0.0, 4.0}, {4.0, 4.0}},     {{0.0, 0.0}, {0.0, 4.0}},
+  };
+}
+
+// A robot deep in a strip too narrow to turn in, 6 deg off its axis (as one
+// that tried to turn there), with the rest of the hall unexplored behind it:
+// it must back out along the way it came (backing straight, the rear runs
+// into the strip's wall within a metre) to where it can turn, and explore
+// the hall. The robot is driven in by fixed commands while the explorer
+// only maps (its commands are not applied: straight in at 0.3 m/s, axle
+// from x = 2.5 to 6.1 m on the strip's axis, then a turn in place of 6 deg);
+// then the explorer drives.
+TEST(ExplorerClosedLoopTest, BacksOutOfADeadEndStripAlongTheWayItCame) {
+  const std::vector<Wall> walls = HallWithMiddleStrip();
+  KinematicSim::Config config;
+  config.max_range_m = 10.0;
+  const Pose2 start(2.5 + config.a_m, 2.0, 0.0);
+  KinematicSim sim(walls, start, config);
+  ExplorerParams params;
+  params.initial_turn_deg = 0.0;
+  Explorer explorer(params, config.a_m);
+  testing::SeenArea seen(walls, start.translation());
+  const double dt = 0.1;
+  double t = 0.0;
+  auto step = [&](const Twist2* fixed) {
+    const LaserScan scan = sim.Scan(t);
+    seen.Add(scan, sim.X_WR() * config.X_RS);
+    const ExplorerOutput out = explorer.Step(sim.X_WR(), &scan, config.X_RS, t, dt);
+    sim.Step(fixed != nullptr ? *fixed : out.command, dt);
+    t += dt;
+    return out;
+  };
+  const Twist2 drive_in{0.3, 0.0};
+  for (int k = 0; k < 120; ++k) step(&drive_in);
+  const Twist2 turn{0.0, DegToRad(6.0) / 0.5};
+  for (int k = 0; k < 5; ++k) step(&turn);
+  ASSERT_GT(sim.X_WR().x, 6.0);
+  ASSERT_NEAR(sim.X_WR().theta, DegToRad(6.0), 1e-9);
+  ASSERT_FALSE(explorer.finished());
+  ASSERT_EQ(sim.contacts(), 0);
+  // The explorer drives from here.
+  double least_x = sim.X_WR().x;
+  ExplorerOutput out;
+  while (t < 400.0 && !out.finished) {
+    out = step(nullptr);
+    least_x = std::min(least_x, sim.X_WR().x);
+  }
+  std::printf("strip 0.65 m: %s after %.1f s, %.1f %% seen, least x of h %.2f m, %d contacts\n",
+              out.finish_reason.c_str(), t, 100.0 * seen.Fraction(), least_x, sim.contacts());
+  EXPECT_TRUE(out.finished);
+  // The axle (a behind h) got back to where it can turn: 0.4 m from the
+  // hall's east wall.
+  EXPECT_LT(least_x - config.a_m, 4.0 - params.turn_clearance_m);
+  EXPECT_GE(seen.Fraction(), 0.99);
+  EXPECT_EQ(sim.contacts(), 0);
+}
+
 // Every goal sees its frontier point: no wall crosses the segment from the
 // goal (the axle's cell) to the point (a goal behind a wall would be
 // reached and see nothing). In the corridor and room of the standard doors

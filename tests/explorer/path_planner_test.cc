@@ -131,6 +131,64 @@ TEST(PathPlannerTest, HairpinBecomesAStopAndTurnPoint) {
   EXPECT_EQ(stops, 1);
 }
 
+// A room's wall 0.15 m thick along y in [3.25, 3.4] with a 0.85 m door at
+// x in [1.875, 2.725] (the 40 x 30 m building's), mapped from both sides.
+std::vector<Wall> WallWithDoor() {
+  std::vector<Wall> walls = testing::Box(-1.0, 0.0, 5.0, 6.0);
+  for (const Wall& wall : testing::Box(-1.0, 3.25, 1.875, 3.4)) walls.push_back(wall);
+  for (const Wall& wall : testing::Box(2.725, 3.25, 5.0, 3.4)) walls.push_back(wall);
+  return walls;
+}
+
+// An axle stopped in front of the door, anywhere within 0.3 m of where the
+// building's robot was (a cell's centre 0.3 m before the wall, a little off
+// the door's middle): its path through the door starts with the leg through
+// it, not with a leg of a cell or two that turns it away first (seen as a
+// robot turning left and right in front of a door for 1,400 s, each turn
+// restarted by the replan: the axle never moved, h swung past the short
+// leg's end). Every path from those starts: no stop-and-turn point after the
+// first within 0.2 m of the axle's cell (the tracker takes one within 0.1 m
+// of h as reached), and the path starts within 0.2 m of the axle.
+TEST(PathPlannerTest, PathThroughADoorDoesNotStartWithATinyLeg) {
+  const ExplorerParams params;
+  const std::vector<Wall> walls = WallWithDoor();
+  OccupancyGrid grid{OccupancyGridSettings{}};
+  testing::KinematicSim::Config config;
+  config.max_range_m = 10.0;
+  for (const Pose2& view : {Pose2(2.3, 1.5, 0.5 * kPi), Pose2(2.3, 1.5, -0.5 * kPi),
+                            Pose2(2.3, 5.0, 0.5 * kPi), Pose2(2.3, 5.0, -0.5 * kPi),
+                            Pose2(2.3, 2.9, 0.5 * kPi)}) {
+    testing::KinematicSim sim(walls, view, config);
+    grid.InsertScan(sim.Scan(0.0), sim.X_WR() * config.X_RS);
+  }
+  const Eigen::Vector2d goal(3.475, 5.375);
+  int tiny = 0;
+  int plans = 0;
+  for (double dx = -0.3; dx <= 0.3 + 1e-9; dx += 0.025) {
+    for (double dy = -0.3; dy <= 0.0 + 1e-9; dy += 0.025) {
+      const Eigen::Vector2d start(2.375 + dx, 2.975 + dy);
+      const NavigationMap map(grid, params, start);
+      const Path path = PlanPath(map, params, goal, 0.5 * kPi);
+      if (path.empty()) continue;
+      ++plans;
+      EXPECT_LT((path.front().p_W - start).norm(), 0.2);
+      for (size_t i = 1; i < path.size(); ++i) {
+        const Eigen::Vector2i cell = grid.CellOf(start);
+        const Eigen::Vector2d start_cell = grid.CellCenter(cell.x(), cell.y());
+        const double from_start_m = (path[i].p_W - start_cell).norm();
+        if (path[i].turn_in_place && from_start_m < 0.2 - 1e-9) {
+          ++tiny;
+          ADD_FAILURE() << "start (" << start.x() << ", " << start.y() << "): a stop "
+                        << from_start_m << " m away";
+          break;
+        }
+      }
+    }
+  }
+  EXPECT_GE(plans, 100);
+  EXPECT_EQ(tiny, 0);
+}
+
 TEST(PathPlannerTest, ClearanceIsTheDistanceToTheNearestOccupiedCell) {
   const ExplorerParams params;
   const OccupancyGrid grid = MappedLCorridor();
