@@ -30,11 +30,14 @@ struct ClosedLoop::World {
   World(const RunConfig& config, const Rng& run_rng)
       : simulator(config.run.world, config.run.robot_model, config.sim, config.robot),
         laser_noise(config.laser, run_rng),
-        odometry(config.robot, config.odometry, run_rng) {}
+        odometry(config.robot, config.odometry, run_rng),
+        drive_rng(run_rng.Fork("sim.drive_disturbance")) {}
 
   sim::Simulator simulator;
   sim::LaserNoise laser_noise;
   sim::WheelOdometry odometry;
+  // The drive's disturbance, drawn at every control step when it is on.
+  Rng drive_rng;
   std::optional<explorer::WaypointDriver> tour;
   std::optional<explorer::Explorer> explorer;
   std::optional<TrueCoverage> coverage;
@@ -247,6 +250,12 @@ void ClosedLoop::Advance() {
   finished_ = out_.finished;
   if (world_ && !finished_ && step_ < last_step_) {
     World& w = *world_;
+    const double disturbance = config_.sim.drive_disturbance_std_fraction;
+    if (disturbance > 0.0) {
+      const double e_v = w.drive_rng.Gaussian(0.0, disturbance);
+      const double e_w = w.drive_rng.Gaussian(0.0, disturbance);
+      w.simulator.SetDriveFactors(1.0 + e_v, 1.0 + e_w);
+    }
     w.simulator.Advance(dt_s_);
     const int contacts = w.simulator.CountRobotWorldContacts();
     if (contacts > 0) ++w.contact_steps;

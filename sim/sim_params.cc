@@ -12,6 +12,8 @@ std::vector<ParamProblem> SimParams::Validate() const {
   check.InRange("settle_time_s", settle_time_s, 0.0, 10.0);
   check.Positive("wheel_speed_kp_nms_per_rad", wheel_speed_kp_nms_per_rad);
   check.NonNegative("wheel_speed_ki_nm_per_rad", wheel_speed_ki_nm_per_rad);
+  // Beyond a third, 1 + e would often be negative: the wheels would turn backwards.
+  check.InRange("drive_disturbance_std_fraction", drive_disturbance_std_fraction, 0.0, 0.3);
   return check.problems();
 }
 

@@ -26,6 +26,17 @@ struct SimParams {
   /// Integral gain of each wheel's speed controller, N m per rad of
   /// accumulated speed error (removes the steady-state error under load).
   double wheel_speed_ki_nm_per_rad = 50.0;
+  /// The drive's run-to-run variation (floor, tyres, motor controllers),
+  /// standard deviation as a fraction: at every control step of a simulated
+  /// run the wheel-speed set points are those of the command (v, w) scaled to
+  /// (v (1 + e_v), w (1 + e_w)), e_v and e_w drawn independently from
+  /// N(0, this) by the run's random stream "sim.drive_disturbance" (so the
+  /// runs of a sweep are independent realisations of the motion, as a real
+  /// robot's are). The filters are given the command, not the disturbed set
+  /// points. 0 (the default): no draws, and the robot's motion is a
+  /// deterministic function of its commands, the same in every run that
+  /// issues the same commands.
+  double drive_disturbance_std_fraction = 0.0;
 
   template <typename Archive>
   void Serialize(Archive* a) {
@@ -33,6 +44,7 @@ struct SimParams {
     a->Visit(MJSLAM_NVP(settle_time_s));
     a->Visit(MJSLAM_NVP(wheel_speed_kp_nms_per_rad));
     a->Visit(MJSLAM_NVP(wheel_speed_ki_nm_per_rad));
+    a->Visit(MJSLAM_NVP(drive_disturbance_std_fraction));
   }
   std::vector<ParamProblem> Validate() const;
   void ValidateOrThrow() const { ThrowIfProblems(Validate()); }

@@ -8,6 +8,7 @@
 #include <mujoco/mujoco.h>
 
 #include "common/angles.h"
+#include "common/check.h"
 #include "sim/diff_drive.h"
 #include "sim/local_geoms.h"
 #include "sim/local_physics.h"
@@ -102,6 +103,8 @@ struct Simulator::Impl {
 
   Pose2 X_RS;
   Twist2 command;
+  // The drive's disturbance: the set points are those of (v v, w w) of these.
+  Twist2 drive_factors{1.0, 1.0};
   // Wheel-speed controller: set points (rad/s) and integrated errors (rad).
   std::array<double, 2> speed_setpoint_radps{0.0, 0.0};
   std::array<double, 2> speed_error_integral_rad{0.0, 0.0};
@@ -128,6 +131,12 @@ struct Simulator::Impl {
   void Settle();
   void Step();
   void CheckOnFloor() const;
+  // The wheel-speed set points of the command, scaled by the drive's factors.
+  void ApplySetPoints() {
+    const Twist2 asked{command.v_mps * drive_factors.v_mps, command.w_radps * drive_factors.w_radps};
+    const WheelSpeeds wheels = WheelSpeedsFromTwist(asked, robot);
+    speed_setpoint_radps = {wheels.left_radps, wheels.right_radps};
+  }
 
   Pose2 X_WA() const {
     const mjtNum* p = d->xpos + 3 * ids.root_body;
@@ -345,10 +354,15 @@ Simulator& Simulator::operator=(Simulator&&) noexcept = default;
 
 Twist2 Simulator::SetCommand(const Twist2& command) {
   const Twist2 applied = SaturateTwist(command, impl_->robot);
-  const WheelSpeeds wheels = WheelSpeedsFromTwist(applied, impl_->robot);
-  impl_->speed_setpoint_radps = {wheels.left_radps, wheels.right_radps};
   impl_->command = applied;
+  impl_->ApplySetPoints();
   return applied;
+}
+
+void Simulator::SetDriveFactors(double v_factor, double w_factor) {
+  MJSLAM_CHECK(std::isfinite(v_factor) && std::isfinite(w_factor));
+  impl_->drive_factors = Twist2{v_factor, w_factor};
+  impl_->ApplySetPoints();
 }
 
 Twist2 Simulator::command() const { return impl_->command; }

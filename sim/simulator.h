@@ -57,6 +57,14 @@ class Simulator {
   /// The saturated command currently applied.
   Twist2 command() const;
 
+  /// Disturbs the drive: from now on the wheel-speed set points are those of
+  /// (v v_factor, w w_factor) for the command (v, w) applied (this one and
+  /// the next ones, until the next call); command() stays the undisturbed
+  /// command. Factors 1 (the initial ones) leave the set points exact. The
+  /// closed loop draws the factors at every control step from
+  /// SimParams::drive_disturbance_std_fraction. Both must be finite (checked).
+  void SetDriveFactors(double v_factor, double w_factor);
+
   /// Advances the physics by whole timesteps: after the call the simulated
   /// time is the multiple of the timestep nearest to the sum of all durations
   /// requested so far (so ten Advance(0.1) make exactly 1 s). Throws SimError

@@ -73,6 +73,26 @@ TEST_F(SimulatorDriveTest, AdvanceTakesWholeStepsWithoutAccumulatingRoundOff) {
   EXPECT_THROW(sim.Advance(-0.1), SimError);
 }
 
+// The drive's disturbance scales the set points, not the command reported:
+// 2 s at (0.5 m/s, 0.5 rad/s) with factors (1.1, 0.9) against factors 1 ends
+// about 10 % farther along the arc with about 10 % less turn (measured with
+// TrueTwist at the end), and command() is the command as given.
+TEST_F(SimulatorDriveTest, DriveFactorsScaleTheSetPointsNotTheCommand) {
+  const auto drive = [&](double v_factor, double w_factor) {
+    Simulator sim(EmptyWorld(), RobotModelPath(), SimParams{}, RobotParams{}, Pose2(0, 0, 0));
+    sim.SetCommand({0.5, 0.5});
+    sim.SetDriveFactors(v_factor, w_factor);
+    sim.Advance(2.0);
+    EXPECT_DOUBLE_EQ(sim.command().v_mps, 0.5);
+    EXPECT_DOUBLE_EQ(sim.command().w_radps, 0.5);
+    return sim.TrueTwist();
+  };
+  const Twist2 exact = drive(1.0, 1.0);
+  const Twist2 disturbed = drive(1.1, 0.9);
+  EXPECT_NEAR(disturbed.v_mps / exact.v_mps, 1.1, 0.01);
+  EXPECT_NEAR(disturbed.w_radps / exact.w_radps, 0.9, 0.01);
+}
+
 // Drives straight with `speed` until the point h has covered 5 m; returns the
 // heading change (rad) and the lateral offset (m) from the start line.
 std::pair<double, double> DriveStraightFiveMetres(double speed_mps) {
