@@ -396,6 +396,32 @@ def fit_skid(steps):
     return c, math.sqrt(residual2 / turned2)
 
 
+def fit_slip_by_regime(steps, c, gain_v):
+    """(k0, k1, kc): the sideways slip by regime (--slip-by-regime), fitted
+    by maximum likelihood to what the skid c leaves, r, modelled as a
+    zero-mean Gaussian with variance
+        (k0^2 + (k1 v)^2) dth^2 + (kc |w - w_prev|)^2
+    (slam.ekf.lateral_slip_std_m_per_rad, _per_rad_per_mps,
+    _per_radps_change), v = gain_v |fv| the speed the filter predicts with
+    (apply_lag first), dth the true turn and w - w_prev the change of the
+    turn-rate command. Steps with neither a turn nor a change carry no
+    information and are left out."""
+    rows = []
+    for s in steps:
+        r = s["lateral"] - c * (-s["d"] * s["dth"] / s["dt"])
+        turn2 = s["dth"] ** 2
+        if turn2 == 0.0 and s["dw"] == 0.0:
+            continue
+        rows.append((r, turn2, (gain_v * s["fv"]) ** 2 * turn2, s["dw"] ** 2))
+
+    def nll(p):
+        k0, k1, kc = p
+        return gaussian_nll((r, k0 * k0 * t + k1 * k1 * vt + kc * kc * w)
+                            for r, t, vt, w in rows)
+
+    return fit(nll, [1e-4, 1e-3, 1e-4])
+
+
 def print_bins(title, steps, key, edges, normalised):
     """Mean of the squared normalised errors over bins of s[key]."""
     print(f"  {title}:")
@@ -569,6 +595,10 @@ def main():
                         help="keep the command gains at 1 (fit the noise only)")
     parser.add_argument("--no-lag", action="store_true",
                         help="no lag of the wheels behind the command (command_lag_s 0)")
+    parser.add_argument("--slip-by-regime", action="store_true",
+                        help="fit the sideways slip per radian turned on the spot, its growth "
+                             "with the speed and its jolt at a change of the turn rate "
+                             "(fit_slip_by_regime) instead of one value per radian")
     parser.add_argument("--json", help="also write the fitted values to this JSON file")
     parser.add_argument("--consistency", metavar="WORK",
                         help="run the training sweeps in WORK and scale the noise against the "
@@ -632,7 +662,14 @@ def main():
     for name, value in zip(ODOMETRY_NAMES, odometry):
         print(f"      {name}: {value:.4g}")
     print(f"    lateral_skid_s: {c:.4g}")
-    print(f"    lateral_slip_std_m_per_rad: {k:.4g}")
+    slip = fit_slip_by_regime(steps, c, gains[0]) if args.slip_by_regime else None
+    if slip:
+        k0, k1, kc = slip
+        print(f"    lateral_slip_std_m_per_rad: {k0:.4g}")
+        print(f"    lateral_slip_std_m_per_rad_per_mps: {k1:.4g}")
+        print(f"    lateral_slip_std_m_per_radps_change: {kc:.4g}")
+    else:
+        print(f"    lateral_slip_std_m_per_rad: {k:.4g}")
 
     print(f"# command noise fitted to errors summed over {args.window} step(s)")
     print("# summed errors over windows of L steps: mean e^2 / model variance, distance and turn")
@@ -679,6 +716,9 @@ def main():
     if args.json:
         values = {"steps": len(steps), "runs": len(runs),
                   **ekf_values(gains, lag, command, odometry, c, k)}
+        if slip:
+            values.update(zip(["lateral_slip_std_m_per_rad", "lateral_slip_std_m_per_rad_per_mps",
+                               "lateral_slip_std_m_per_radps_change"], slip))
         with open(args.json, "w") as f:
             json.dump(values, f, indent=2)
             f.write("\n")

@@ -223,8 +223,16 @@ MotionInput EkfSlam::CheckedMotionInput(const SensorRecord& record) const {
                          params_.command_gain_v, params_.command_gain_w, &followed,
                          previous_change_);
   }
-  const double slip_std = params_.lateral_slip_std_m_per_rad * std::abs(input.increment.y());
+  const double speed_mps = record.dt_s > 0.0 ? std::abs(input.increment.x()) / record.dt_s : 0.0;
+  const double slip_per_rad = std::hypot(params_.lateral_slip_std_m_per_rad,
+                                         params_.lateral_slip_std_m_per_rad_per_mps * speed_mps);
+  const double slip_std = slip_per_rad * std::abs(input.increment.y());
   input.lateral_variance_m2 = slip_std * slip_std;
+  if (params_.input != "odometry") {
+    const double change_std = params_.lateral_slip_std_m_per_radps_change *
+                              std::abs(record.command.w_radps - previous_command_.w_radps);
+    input.lateral_variance_m2 += change_std * change_std;
+  }
   if (record.dt_s > 0.0) input.skid_per_m_rad = params_.lateral_skid_s / record.dt_s;
   input.integration = integration_;
   return input;

@@ -79,6 +79,8 @@ std::vector<ParamProblem> EkfParams::Validate() const {
   check.Merge("command_noise", command_noise.Validate());
   check.Merge("odometry_noise", odometry_noise.Validate());
   check.NonNegative("lateral_slip_std_m_per_rad", lateral_slip_std_m_per_rad);
+  check.NonNegative("lateral_slip_std_m_per_rad_per_mps", lateral_slip_std_m_per_rad_per_mps);
+  check.NonNegative("lateral_slip_std_m_per_radps_change", lateral_slip_std_m_per_radps_change);
   check.NonNegative("lateral_skid_s", lateral_skid_s);
   check.OneOf("jacobians", jacobians,
               std::vector<std::string>(std::begin(kJacobianPointNames),

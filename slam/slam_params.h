@@ -192,6 +192,19 @@ struct EkfParams {
   /// prediction adds (k |dth|)^2 of variance across the mid-arc heading
   /// (docs/method.md, departure 10).
   double lateral_slip_std_m_per_rad = 0.005;
+  /// Growth of that slip with the speed, metres per radian per (m/s): the
+  /// slip per radian turned is hypot(lateral_slip_std_m_per_rad, this |v|),
+  /// v = d / dt of the step's increment (0 when dt = 0), so that a turn on
+  /// the spot and a turn while driving each get their own spread. 0 (the
+  /// default): one value for all turns (docs/method.md, departure 23).
+  double lateral_slip_std_m_per_rad_per_mps = 0.0;
+  /// Sideways slip of R at a change of the turn-rate command, one standard
+  /// deviation, metres per rad/s of change, with the command input only:
+  /// the prediction adds (this |w - w_previous|)^2 of variance across the
+  /// mid-arc heading, w_previous the command of the record before (a robot
+  /// that starts or stops turning jolts sideways). 0 (the default): none
+  /// (docs/method.md, departure 23).
+  double lateral_slip_std_m_per_radps_change = 0.0;
   /// Sideways skid of the axle centre in turns, seconds: Eq. (6) has no
   /// sideways motion, but tyres skid to the outside of a turn at a speed
   /// proportional to the centripetal acceleration, c v w. The prediction
@@ -294,6 +307,8 @@ struct EkfParams {
     a->Visit(MJSLAM_NVP(command_noise));
     a->Visit(MJSLAM_NVP(odometry_noise));
     a->Visit(MJSLAM_NVP(lateral_slip_std_m_per_rad));
+    a->Visit(MJSLAM_NVP(lateral_slip_std_m_per_rad_per_mps));
+    a->Visit(MJSLAM_NVP(lateral_slip_std_m_per_radps_change));
     a->Visit(MJSLAM_NVP(lateral_skid_s));
     a->Visit(MJSLAM_NVP(jacobians));
     a->Visit(MJSLAM_NVP(initial_position_std_m));

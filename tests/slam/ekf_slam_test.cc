@@ -62,6 +62,8 @@ TEST(EkfParamsTest, DefaultsAreValidAndBadValuesAreNamed) {
   params.new_feature_probability = 0.5;
   params.max_updates = 0;
   params.command_noise.v_noise_fraction = -1.0;
+  params.lateral_slip_std_m_per_rad_per_mps = -0.1;
+  params.lateral_slip_std_m_per_radps_change = -0.1;
   const std::vector<ParamProblem> problems = params.Validate();
   std::string keys;
   for (const ParamProblem& problem : problems) keys += problem.key + " ";
@@ -71,6 +73,8 @@ TEST(EkfParamsTest, DefaultsAreValidAndBadValuesAreNamed) {
   EXPECT_NE(keys.find("new_feature_probability"), std::string::npos) << keys;
   EXPECT_NE(keys.find("max_updates"), std::string::npos) << keys;
   EXPECT_NE(keys.find("command_noise.v_noise_fraction"), std::string::npos) << keys;
+  EXPECT_NE(keys.find("lateral_slip_std_m_per_rad_per_mps"), std::string::npos) << keys;
+  EXPECT_NE(keys.find("lateral_slip_std_m_per_radps_change"), std::string::npos) << keys;
   EXPECT_THROW(params.ValidateOrThrow(), ParamError);
 }
 
@@ -229,6 +233,61 @@ TEST(EkfSlamTest, SettleNoiseWidensTheStepAfterAChange) {
               0.01 * (sigma_first * sigma_first + sigma_second * sigma_second +
                       8 * sigma_v * sigma_v),
               1e-12);
+}
+
+// The sideways slip by regime (lateral_slip_std_m_per_rad_per_mps,
+// lateral_slip_std_m_per_radps_change): with every other noise off, the
+// position's variance is the slips' alone, added across the heading.
+EkfParams SlipOnlyParams() {
+  EkfParams params;
+  params.command_noise = CommandNoiseParams{};
+  params.command_noise.v_noise_std_mps = 1e-12;  // one of the floors must be > 0
+  params.command_noise.v_noise_fraction = 0.0;
+  params.command_noise.w_noise_std_radps = 0.0;
+  params.command_noise.w_noise_fraction = 0.0;
+  params.command_noise.change_noise_fraction = 0.0;
+  params.command_lag_s = 0.0;
+  params.lateral_skid_s = 0.0;
+  params.lateral_slip_std_m_per_rad = 0.001;
+  return params;
+}
+
+double PositionVarianceAfter(const EkfParams& params, const std::vector<Twist2>& commands) {
+  EkfSlam filter(params, CorrectionMode::kClassical, Pose2(1.0, 2.0, 0.3), Pose2());
+  SensorRecord record;
+  record.dt_s = 0.1;
+  for (const Twist2& command : commands) {
+    record.command = command;
+    filter.Step(record, nullptr);
+  }
+  return filter.pose_covariance().topLeftCorner<2, 2>().trace();
+}
+
+TEST(EkfSlamTest, SlipPerRadianGrowsWithTheSpeed) {
+  EkfParams params = SlipOnlyParams();
+  params.lateral_slip_std_m_per_rad_per_mps = 0.01;
+  // On the spot: 0.001 m/rad of the 0.05 rad turned; at 0.5 m/s:
+  // hypot(0.001, 0.01 * 0.5) m/rad.
+  EXPECT_NEAR(PositionVarianceAfter(params, {{0.0, 0.5}}), std::pow(0.001 * 0.05, 2), 1e-18);
+  EXPECT_NEAR(PositionVarianceAfter(params, {{0.5, 0.5}}),
+              std::pow(std::hypot(0.001, 0.005) * 0.05, 2), 1e-18);
+  params.lateral_slip_std_m_per_rad_per_mps = 0.0;
+  EXPECT_NEAR(PositionVarianceAfter(params, {{0.5, 0.5}}), std::pow(0.001 * 0.05, 2), 1e-18);
+}
+
+TEST(EkfSlamTest, SlipAtAChangeOfTheTurnRate) {
+  EkfParams params = SlipOnlyParams();
+  params.lateral_slip_std_m_per_rad = 0.0;
+  params.lateral_slip_std_m_per_radps_change = 0.001;
+  // Turning from rest at 0.5 rad/s, held, stopped: two changes of 0.5 rad/s,
+  // 0.5 mm each; the held step adds nothing, nor a change of the speed.
+  EXPECT_NEAR(PositionVarianceAfter(params, {{0.0, 0.5}, {0.0, 0.5}, {0.0, 0.0}}),
+              2.0 * std::pow(0.001 * 0.5, 2), 1e-18);
+  EXPECT_NEAR(PositionVarianceAfter(params, {{0.5, 0.0}, {0.0, 0.0}}), 0.0, 1e-18);
+  // With odometry the command's change is not the robot's: no slip from it.
+  params.input = "odometry";
+  params.odometry_noise = OdometryNoiseParams{0.0, 0.0, 0.0, 0.0, 0.0};
+  EXPECT_NEAR(PositionVarianceAfter(params, {{0.0, 0.5}, {0.0, 0.0}}), 0.0, 1e-18);
 }
 
 TEST(EkfSlamTest, PredictsFromOdometry) {
