@@ -5,7 +5,7 @@ slam.ekf.lateral_skid_s and slam.ekf.lateral_slip_std_m_per_rad
 (docs/method.md, "Calibrating the process noise").
 
     scripts/calibrate_noise.py DIR [DIR ...] [--offset A] [--window L] [--no-gain] [--no-lag]
-                               [--json FILE]
+                               [--slip-by-regime] [--json FILE]
     scripts/calibrate_noise.py --consistency WORK --write CONFIG [--config BASE] [--seed S]
                                [--runs N] [--jobs J] [--iterations K] [--tolerance T]
 
@@ -48,7 +48,11 @@ an arc along the mid-arc heading, plus a sideways skid):
   the distance rolled and the angle turned), fitted by maximum likelihood.
 - skid: the sideways motion of the axle, -c v w dt, c by least squares
   (as scripts/measure_skid.py); what is left, per radian turned, is
-  lateral_slip_std_m_per_rad (root of sum(r^2) / sum(dth^2)).
+  lateral_slip_std_m_per_rad (root of sum(r^2) / sum(dth^2)); with
+  --slip-by-regime, instead, the slip per radian on the spot, its growth with
+  the speed and the slip at a change of the turn rate
+  (lateral_slip_std_m_per_rad, _per_rad_per_mps, _per_radps_change;
+  docs/method.md, departure 23), by maximum likelihood (fit_slip_by_regime).
 
 Prints the fitted values as the YAML of configs/default.yaml's slam.ekf
 section, and for each fit the mean of (error / sigma)^2 (1 for a model that

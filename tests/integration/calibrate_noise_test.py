@@ -1,6 +1,6 @@
 #!/usr/bin/python3
 """Test of scripts/calibrate_noise.py's command-following fit: it must recover the gains, the
-lag and the settling wheels' noise of a robot made with known ones.
+lag, the settling wheels' noise and the sideways slip by regime of a robot made with known ones.
 
     /usr/bin/python3 tests/integration/calibrate_noise_test.py SOURCE_DIR
 
@@ -9,10 +9,15 @@ at the commands through a first-order lag of tau = 0.05 s, times the gains 0.99 
 (turn rate), plus white noise of 1 mm/s and 5 mrad/s and, in the period after each change of the
 command, 0.1 of that change (the settling wheels, slam.ekf.command_noise.settle_noise_fraction);
 the robot at rest before the first row; the point R 0.2 m ahead of the axle, as the script
-assumes. Asserted: the fitted command_lag_s within 0.005 s of 0.05, command_gain_v within 0.002
-of 0.99, command_gain_w within 0.005 of 1.01, settle_noise_fraction within 0.02 of 0.1. Shown by
-hand to fail: with the script's lag left at 0 (--no-lag) the gains are still found but the test
-fails on the lag; with the settle term left out of the script's sigmas it fails on it.
+assumes. The axle also slips sideways (across the mid-arc heading) by a zero-mean Gaussian of
+variance (K0^2 + (K1 v)^2) dth^2 + (KC |w - w_prev|)^2 (slam.ekf.lateral_slip_std_m_per_rad,
+_per_rad_per_mps, _per_radps_change; v the speed the filter predicts with; its own random
+stream), fitted with --slip-by-regime. Asserted: the fitted command_lag_s within 0.005 s of 0.05, command_gain_v within 0.002
+of 0.99, command_gain_w within 0.005 of 1.01, settle_noise_fraction within 0.02 of 0.1, each
+slip within 20 % of its value. Shown by hand to fail: with the script's lag left at 0 (--no-lag)
+the gains are still found but the test fails on the lag; with the settle term left out of the
+script's sigmas it fails on it; with the change term left out of fit_slip_by_regime's variance
+it fails on the slips.
 
 Exit status 0 when the values are recovered, 1 with the reasons otherwise.
 """
@@ -32,11 +37,15 @@ GAIN_W = 1.01
 SETTLE = 0.1
 OFFSET = 0.2
 DT = 0.1
+K0 = 2e-4   # m/rad
+K1 = 2e-3   # m/rad per m/s
+KC = 5e-4   # m per rad/s
 
 
 def write_run(directory, seed):
     """One run's trajectory.csv with the columns calibrate_noise.py reads."""
     rng = random.Random(seed)
+    slip_rng = random.Random(seed + 1000)
     os.makedirs(directory)
     x = y = th = 0.0
     fv = fw = 0.0
@@ -60,12 +69,16 @@ def write_run(directory, seed):
             fw += beta * (w - fw)
             d = (GAIN_V * fv + rng.gauss(0, 0.001 + SETTLE * settle[0])) * DT
             dth = (GAIN_W * fw + rng.gauss(0, 0.005 + SETTLE * settle[1])) * DT
+            lateral = slip_rng.gauss(0, math.sqrt((K0 ** 2 + (K1 * GAIN_V * fv) ** 2) * dth ** 2
+                                                  + (KC * abs(w - previous[1])) ** 2))
             settle = [abs(v - previous[0]), abs(w - previous[1])]
             previous = [v, w]
             half = 0.5 * dth
             chord = d * (math.sin(half) / half if abs(half) > 1e-9 else 1.0)
             x += chord * math.cos(th + half)
             y += chord * math.sin(th + half)
+            x -= lateral * math.sin(th + half)
+            y += lateral * math.cos(th + half)
             th = math.remainder(th + dth, 2.0 * math.pi)
 
 
@@ -79,7 +92,7 @@ def main(source_dir):
         fitted = os.path.join(out, "fit.json")
         result = subprocess.run(["/usr/bin/python3",
                                  os.path.join(source_dir, "scripts", "calibrate_noise.py"),
-                                 *runs, "--offset", str(OFFSET), "--json", fitted]
+                                 *runs, "--offset", str(OFFSET), "--slip-by-regime", "--json", fitted]
                                 + sys.argv[2:], capture_output=True, text=True)
         if result.returncode != 0:
             print(result.stdout + result.stderr)
@@ -90,7 +103,15 @@ def main(source_dir):
               f"{values['command_gain_v']:.4f} ({GAIN_V}), command_gain_w "
               f"{values['command_gain_w']:.4f} ({GAIN_W}), settle_noise_fraction "
               f"{values['command_noise']['settle_noise_fraction']:.4f} ({SETTLE})")
+        print(f"fitted slips: {values['lateral_slip_std_m_per_rad']:.3g} ({K0}), "
+              f"{values['lateral_slip_std_m_per_rad_per_mps']:.3g} ({K1}), "
+              f"{values['lateral_slip_std_m_per_radps_change']:.3g} ({KC})")
         problems = []
+        for key, made in (("lateral_slip_std_m_per_rad", K0),
+                          ("lateral_slip_std_m_per_rad_per_mps", K1),
+                          ("lateral_slip_std_m_per_radps_change", KC)):
+            if abs(values[key] / made - 1.0) > 0.2:
+                problems.append(f"{key}: fitted {values[key]:.4g}, made {made} (tolerance 20 %)")
         for key, made, tolerance in (("command_lag_s", TAU, 0.005),
                                      ("command_gain_v", GAIN_V, 0.002),
                                      ("command_gain_w", GAIN_W, 0.005),
