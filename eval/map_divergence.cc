@@ -274,8 +274,9 @@ std::vector<double> LogPmf(const GaussianMixture& mixture, const std::vector<Eig
         const Eigen::Vector3d& w = inverse[k];
         const double term =
             log_scale[k] - 0.5 * (w(0) * dx * dx + 2.0 * w(1) * dx * dy + w(2) * dy * dy);
-        kept.emplace_back(k, term);
         largest = std::max(largest, term);
+        // A term already 40 below the largest found stays below the cutoff.
+        if (term > largest - 40.0) kept.emplace_back(k, term);
       }
       evaluated += node.end - node.begin;
     }
