@@ -205,7 +205,7 @@ std::vector<double> LogPmf(const GaussianMixture& mixture, const std::vector<Eig
   for (std::size_t k = 0; k < num; ++k) {
     const Eigen::Matrix2d& C = mixture.covariances[k];
     const double det = C(0, 0) * C(1, 1) - C(0, 1) * C(1, 0);
-    MJSLAM_CHECK(det > 0.0);
+    MJSLAM_CHECK(det > 0.0 && mixture.means[k].allFinite());
     inverse[k] = {C(1, 1) / det, -C(0, 1) / det, C(0, 0) / det};
     log_scale[k] = std::log(mixture.weights[k]) - std::log(2.0 * kPi) - 0.5 * std::log(det);
     const double mid = 0.5 * (C(0, 0) + C(1, 1));
