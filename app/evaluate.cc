@@ -7,6 +7,7 @@
 #include <fstream>
 #include <stdexcept>
 
+#include "app/cpu_profile.h"  // CpuLaps
 #include "app/run_config.h"
 #include "common/interrupt.h"
 #include "common/rng.h"
@@ -118,22 +119,27 @@ std::vector<double> PoseNees(const CsvTable& trajectory, const std::string& name
 }
 
 RunEvaluation EvaluateRunDirectory(const std::string& run_dir, const EvaluateOptions& options) {
+  const double start_s = ThreadCpuSeconds();
+  RunEvaluation result;
   options.ground_truth.ValidateOrThrow();
   options.match.ValidateOrThrow();
   options.divergence.ValidateOrThrow();
   const nlohmann::json manifest = rundir::ReadManifest(run_dir);
   // Not while a run (or another evaluation) writes there.
   const rundir::RunDirectoryLock lock(run_dir);
+  CpuLaps laps;
+  laps.Start();
   const CsvTable trajectory =
       rundir::ReadTrajectoryCsv(rundir::PathIn(run_dir, rundir::kTrajectoryFile));
+  laps.Charge(&result.cpu.trajectory_s);
   // A recording without truth (a real log) has no world to compare with.
   if (std::isnan(trajectory.rows[0][1])) {
     throw std::runtime_error(trajectory.path + ": true_x is nan: no true pose to evaluate against "
                              "(a real log: evaluate the directory mjslam import wrote)");
   }
-  RunEvaluation result;
   result.truth = RunGroundTruth(run_dir, options.ground_truth);
   rundir::WriteMapCsv(rundir::PathIn(run_dir, rundir::kGroundTruthMapFile), result.truth);
+  laps.Charge(&result.cpu.ground_truth_s);
 
   // Poses and maps of both filters.
   std::vector<eval::Map> maps;
@@ -143,8 +149,10 @@ RunEvaluation EvaluateRunDirectory(const std::string& run_dir, const EvaluateOpt
     const std::vector<double> nees = PoseNees(trajectory, name);
     for (std::size_t k = 0; k < steps.size(); ++k) steps[k].nees = nees[k];
     result.pose.push_back(eval::SummarisePoseSteps(steps));
+    laps.Charge(&result.cpu.poses_s);
     maps.push_back(rundir::ReadMapCsv(rundir::PathIn(run_dir, rundir::MapFile(name))));
     result.map.push_back(eval::MatchMaps(maps.back(), result.truth, options.match));
+    laps.Charge(&result.cpu.maps_s);
   }
   if (options.divergence_points > 0) {
     const std::uint64_t seed = manifest.value("seed", std::uint64_t{0});
@@ -153,6 +161,7 @@ RunEvaluation EvaluateRunDirectory(const std::string& run_dir, const EvaluateOpt
         Rng(seed).Fork("evaluate"), options.divergence);
     result.has_divergence = true;
     result.divergence = {rows[0].mean, rows[1].mean, rows[2].mean, rows[3].mean};
+    laps.Charge(&result.cpu.divergence_s);
   }
 
   // Merge into summary.json.
@@ -188,6 +197,8 @@ RunEvaluation EvaluateRunDirectory(const std::string& run_dir, const EvaluateOpt
                              {"selective_truth", result.divergence.selective_truth}};
   }
   rundir::WriteSummary(run_dir, summary);
+  laps.Charge(&result.cpu.summary_s);
+  result.cpu.total_s = ThreadCpuSeconds() - start_s;
   return result;
 }
 

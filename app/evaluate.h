@@ -25,6 +25,25 @@ struct EvaluateOptions {
   int divergence_realisations = 1;
 };
 
+/// CPU seconds (of the calling thread) EvaluateRunDirectory spent in each
+/// stage, as `mjslam evaluate --profile` prints them.
+struct EvaluationCpu {
+  /// Reading trajectory.csv.
+  double trajectory_s = 0.0;
+  /// The world's ground truth map (RunGroundTruth) and ground_truth_map.csv.
+  double ground_truth_s = 0.0;
+  /// Both filters' pose metrics (PoseSteps, PoseNees, SummarisePoseSteps).
+  double poses_s = 0.0;
+  /// Reading both map files and matching them with the truth.
+  double maps_s = 0.0;
+  /// The map divergence (eval::DivergenceStudy).
+  double divergence_s = 0.0;
+  /// Merging into summary.json.
+  double summary_s = 0.0;
+  /// The whole evaluation.
+  double total_s = 0.0;
+};
+
 /// What EvaluateRunDirectory found, per filter in the order of
 /// rundir::FilterNames().
 struct RunEvaluation {
@@ -34,6 +53,8 @@ struct RunEvaluation {
   /// Set when divergence_points > 0.
   bool has_divergence = false;
   eval::MapDivergences divergence;
+  /// Where the evaluation's CPU time went.
+  EvaluationCpu cpu;
 };
 
 /// The true map of a world file: the wall (box) footprints of

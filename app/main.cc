@@ -264,6 +264,7 @@ int ConfigMain(const ConfigOptions& c) {
 struct EvaluateCommand {
   std::string run_dir;
   EvaluateOptions options;
+  bool profile = false;
 };
 
 CLI::App* AddEvaluate(CLI::App* cli, EvaluateCommand* c) {
@@ -277,6 +278,7 @@ CLI::App* AddEvaluate(CLI::App* cli, EvaluateCommand* c) {
                        "Realisations of the divergence (their mean is reported)")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
+  evaluate->add_flag("--profile", c->profile, "Print the CPU seconds of each stage");
   return evaluate;
 }
 
@@ -328,6 +330,13 @@ int EvaluateMain(const EvaluateCommand& c) {
                 "classical||truth %.4g, selective||truth %.4g\n",
                 result.divergence.classical_selective, result.divergence.selective_classical,
                 result.divergence.classical_truth, result.divergence.selective_truth);
+  }
+  if (c.profile) {
+    const EvaluationCpu& cpu = result.cpu;
+    std::printf("cpu s: trajectory %.3f, ground truth %.3f, poses %.3f, maps %.3f, "
+                "divergence %.3f, summary %.3f, total %.3f\n",
+                cpu.trajectory_s, cpu.ground_truth_s, cpu.poses_s, cpu.maps_s, cpu.divergence_s,
+                cpu.summary_s, cpu.total_s);
   }
   return 0;
 }

@@ -2,13 +2,15 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <limits>
+#include <map>
 #include <stdexcept>
 #include <string>
 #include <utility>
 
 #include "common/angles.h"
-#include "common/box_index.h"
+#include "common/box_index.h"  // AlignedBox2
 #include "common/check.h"
 #include "common/interrupt.h"
 
@@ -114,69 +116,180 @@ std::vector<Eigen::Vector2d> UniformPoints(const Box& box, int num_points, Rng* 
   return points;
 }
 
-std::vector<double> LogPmf(const GaussianMixture& mixture,
-                           const std::vector<Eigen::Vector2d>& points) {
+namespace {
+
+// A k-d tree over the means of some Gaussians of a mixture: each node has
+// the box around its Gaussians' means and their largest log-scale and
+// largest covariance eigenvalue, so that every term of its Gaussians at a
+// point is at most max_log_scale - d^2 / (2 max_eigenvalue), d the point's
+// distance to the box.
+class GaussianTree {
+ public:
+  struct Node {
+    AlignedBox2 box;
+    double max_log_scale = -std::numeric_limits<double>::infinity();
+    double max_eigenvalue = 0.0;
+    int begin = 0;  // members_[begin .. end)
+    int end = 0;
+    int first_child = -1;  // children first_child, first_child + 1; -1: a leaf
+  };
+
+  // A tree over `members` (indices into `means`, `log_scale`, `eigenvalue`).
+  GaussianTree(std::vector<int> members, const std::vector<Eigen::Vector2d>& means,
+               const std::vector<double>& log_scale, const std::vector<double>& eigenvalue)
+      : members_(std::move(members)) {
+    nodes_.push_back({});
+    Build(0, 0, static_cast<int>(members_.size()), means, log_scale, eigenvalue);
+  }
+
+  const std::vector<Node>& nodes() const { return nodes_; }
+  const std::vector<int>& members() const { return members_; }
+
+ private:
+  static constexpr int kLeafSize = 8;
+
+  void Build(int node, int begin, int end, const std::vector<Eigen::Vector2d>& means,
+             const std::vector<double>& log_scale, const std::vector<double>& eigenvalue) {
+    Node n;
+    n.begin = begin;
+    n.end = end;
+    n.box = {means[members_[begin]], means[members_[begin]]};
+    for (int m = begin; m < end; ++m) {
+      const int k = members_[m];
+      n.box.lo = n.box.lo.cwiseMin(means[k]);
+      n.box.hi = n.box.hi.cwiseMax(means[k]);
+      n.max_log_scale = std::max(n.max_log_scale, log_scale[k]);
+      n.max_eigenvalue = std::max(n.max_eigenvalue, eigenvalue[k]);
+    }
+    if (end - begin > kLeafSize) {
+      // Split at the median along the box's longer side.
+      const int axis = (n.box.hi - n.box.lo).x() >= (n.box.hi - n.box.lo).y() ? 0 : 1;
+      const int middle = begin + (end - begin) / 2;
+      std::nth_element(members_.begin() + begin, members_.begin() + middle,
+                       members_.begin() + end, [&means, axis](int a, int b) {
+                         return means[a](axis) < means[b](axis) ||
+                                (means[a](axis) == means[b](axis) && a < b);
+                       });
+      n.first_child = static_cast<int>(nodes_.size());
+      nodes_.push_back({});
+      nodes_.push_back({});
+      Build(n.first_child, begin, middle, means, log_scale, eigenvalue);
+      Build(n.first_child + 1, middle, end, means, log_scale, eigenvalue);
+    }
+    nodes_[node] = n;
+  }
+
+  std::vector<int> members_;
+  std::vector<Node> nodes_;
+};
+
+// The bound of a node's terms at p (+1 for rounding): every Gaussian of the
+// node has its term at p below it.
+double TermBound(const GaussianTree::Node& node, const Eigen::Vector2d& p) {
+  const double dx = std::max({node.box.lo.x() - p.x(), 0.0, p.x() - node.box.hi.x()});
+  const double dy = std::max({node.box.lo.y() - p.y(), 0.0, p.y() - node.box.hi.y()});
+  return node.max_log_scale - 0.5 * (dx * dx + dy * dy) / node.max_eigenvalue + 1.0;
+}
+
+}  // namespace
+
+std::vector<double> LogPmf(const GaussianMixture& mixture, const std::vector<Eigen::Vector2d>& points,
+                           std::int64_t* terms_evaluated) {
   MJSLAM_CHECK(!mixture.means.empty());
-  // Per Gaussian: log(weight / (2 pi sqrt(det C))) and the inverse of C.
+  // Per Gaussian: log(weight / (2 pi sqrt(det C))), the inverse of C and
+  // its largest eigenvalue.
   const std::size_t num = mixture.means.size();
   std::vector<double> log_scale(num);
   std::vector<Eigen::Vector3d> inverse(num);  // (a, b, c) of [[a, b], [b, c]]
+  std::vector<double> eigenvalue(num);
   for (std::size_t k = 0; k < num; ++k) {
     const Eigen::Matrix2d& C = mixture.covariances[k];
     const double det = C(0, 0) * C(1, 1) - C(0, 1) * C(1, 0);
-    MJSLAM_CHECK(det > 0.0);
+    MJSLAM_CHECK(det > 0.0 && mixture.means[k].allFinite());
     inverse[k] = {C(1, 1) / det, -C(0, 1) / det, C(0, 0) / det};
     log_scale[k] = std::log(mixture.weights[k]) - std::log(2.0 * kPi) - 0.5 * std::log(det);
-  }
-  // Every term is at most max_log_scale - d^2 / (2 max_eigenvalue) at a
-  // distance d from its mean, so a point needs only the Gaussians near it:
-  // those in a square around it, grown until every Gaussian outside it is
-  // more than 40 (+1 for rounding) below the largest term inside. The terms
-  // kept are the same, summed in the same order, as over all Gaussians.
-  double max_log_scale = -std::numeric_limits<double>::infinity();
-  double max_eigenvalue = 0.0;
-  std::vector<AlignedBox2> at_means(num);
-  for (std::size_t k = 0; k < num; ++k) {
-    const Eigen::Matrix2d& C = mixture.covariances[k];
     const double mid = 0.5 * (C(0, 0) + C(1, 1));
     const double half_gap = std::hypot(0.5 * (C(0, 0) - C(1, 1)), C(0, 1));
-    max_eigenvalue = std::max(max_eigenvalue, mid + half_gap);
-    max_log_scale = std::max(max_log_scale, log_scale[k]);
-    at_means[k] = {mixture.means[k], mixture.means[k]};
+    eigenvalue[k] = mid + half_gap;
   }
-  const BoxIndex index(at_means);
-  const double first_radius = std::sqrt(2.0 * max_eigenvalue * 50.0);
+  // A term is at most log_scale - d^2 / (2 eigenvalue) at a distance d from
+  // its mean, so a point needs only the Gaussians near it: one k-d tree per
+  // octave of the largest eigenvalue (so that a node's bound is not set by
+  // much wider Gaussians) is searched best bound first, and a node is left
+  // out once its bound lies more than 40 (+1 for rounding) below the
+  // largest term found. That largest term only grows, so every term left
+  // out is more than 40 below the largest of all; the terms kept are summed
+  // in the order of the mixture: the same sum as over all Gaussians, bit for
+  // bit.
+  std::map<int, std::vector<int>> by_octave;
+  for (std::size_t k = 0; k < num; ++k) {
+    by_octave[std::ilogb(eigenvalue[k])].push_back(static_cast<int>(k));
+  }
+  std::vector<GaussianTree> trees;
+  for (auto& [exponent, members] : by_octave) {
+    trees.emplace_back(std::move(members), mixture.means, log_scale, eigenvalue);
+  }
+  std::int64_t evaluated = 0;
   std::vector<double> log_density(points.size());
-  std::vector<double> terms;
+  std::vector<std::pair<int, double>> kept;  // (Gaussian, term)
+  struct Pending {
+    double bound;
+    int tree;
+    int node;
+    bool operator<(const Pending& other) const { return bound < other.bound; }
+  };
+  std::vector<Pending> queue;  // a max-heap by bound
   for (std::size_t i = 0; i < points.size(); ++i) {
     // A stop request is noticed every 1024 points (well under a second).
     if (i % 1024 == 0) ThrowIfInterrupted("map divergence");
-    std::vector<int> near;
+    const Eigen::Vector2d& p = points[i];
     double largest = -std::numeric_limits<double>::infinity();
-    for (double radius = first_radius;; radius *= 2.0) {
-      const Eigen::Vector2d reach = Eigen::Vector2d::Constant(radius);
-      near = index.Candidates(points[i] - reach, points[i] + reach);
-      terms.resize(near.size());
-      largest = -std::numeric_limits<double>::infinity();
-      for (std::size_t m = 0; m < near.size(); ++m) {
-        const int k = near[m];
-        const double dx = points[i].x() - mixture.means[k].x();
-        const double dy = points[i].y() - mixture.means[k].y();
-        const Eigen::Vector3d& w = inverse[k];
-        terms[m] = log_scale[k] - 0.5 * (w(0) * dx * dx + 2.0 * w(1) * dx * dy + w(2) * dy * dy);
-        largest = std::max(largest, terms[m]);
+    kept.clear();
+    queue.clear();
+    for (std::size_t t = 0; t < trees.size(); ++t) {
+      queue.push_back({TermBound(trees[t].nodes()[0], p), static_cast<int>(t), 0});
+      std::push_heap(queue.begin(), queue.end());
+    }
+    while (!queue.empty()) {
+      std::pop_heap(queue.begin(), queue.end());
+      const Pending next = queue.back();
+      queue.pop_back();
+      // Every node still queued has a bound at most this one's.
+      if (next.bound <= largest - 40.0) break;
+      const GaussianTree& tree = trees[next.tree];
+      const GaussianTree::Node& node = tree.nodes()[next.node];
+      if (node.first_child >= 0) {
+        for (int c = node.first_child; c <= node.first_child + 1; ++c) {
+          const double bound = TermBound(tree.nodes()[c], p);
+          if (bound <= largest - 40.0) continue;
+          queue.push_back({bound, next.tree, c});
+          std::push_heap(queue.begin(), queue.end());
+        }
+        continue;
       }
-      const double outside = max_log_scale - 0.5 * radius * radius / max_eigenvalue + 1.0;
-      if (near.size() == num || (!near.empty() && outside <= largest - 40.0)) break;
+      for (int m = node.begin; m < node.end; ++m) {
+        const int k = tree.members()[m];
+        const double dx = p.x() - mixture.means[k].x();
+        const double dy = p.y() - mixture.means[k].y();
+        const Eigen::Vector3d& w = inverse[k];
+        const double term =
+            log_scale[k] - 0.5 * (w(0) * dx * dx + 2.0 * w(1) * dx * dy + w(2) * dy * dy);
+        largest = std::max(largest, term);
+        // A term already 40 below the largest found stays below the cutoff.
+        if (term > largest - 40.0) kept.emplace_back(k, term);
+      }
+      evaluated += node.end - node.begin;
     }
     // Terms more than 40 below the largest add less than 1e-17 of it.
+    std::sort(kept.begin(), kept.end());
     double sum = 0.0;
     const double cutoff = largest - 40.0;
-    for (std::size_t m = 0; m < near.size(); ++m) {
-      if (terms[m] > cutoff) sum += std::exp(terms[m] - largest);
+    for (const auto& [k, term] : kept) {
+      if (term > cutoff) sum += std::exp(term - largest);
     }
     log_density[i] = largest + std::log(sum);
   }
+  if (terms_evaluated != nullptr) *terms_evaluated = evaluated;
   // Normalise over the points, also in log space.
   double largest = -std::numeric_limits<double>::infinity();
   for (const double l : log_density) largest = std::max(largest, l);

@@ -82,6 +82,38 @@ TEST(EvaluateTest, WritesGroundTruthAndMergesMetricsIntoSummary) {
   EXPECT_GE(summary["divergence"]["classical_truth"].get<double>(), 0.0);
 }
 
+// --profile's stages: each charged once, together within the total; the
+// divergence only when asked for.
+TEST(EvaluateTest, ProfileChargesEachStage) {
+  const std::string dir = FreshDir("evaluate_profile") + "/run";
+  RunRoom(dir, 3);
+  ASSERT_EQ(Shell(Program() + " evaluate " + dir + " --divergence-points 500 --profile > " + dir +
+                  ".eval.log 2>&1"),
+            0)
+      << ReadText(dir + ".eval.log");
+  EXPECT_NE(ReadText(dir + ".eval.log").find("cpu s: trajectory "), std::string::npos)
+      << ReadText(dir + ".eval.log");
+  for (const int points : {0, 2000}) {
+    app::EvaluateOptions options;
+    options.divergence_points = points;
+    const app::EvaluationCpu cpu = app::EvaluateRunDirectory(dir, options).cpu;
+    const double stages[] = {cpu.trajectory_s, cpu.ground_truth_s, cpu.poses_s, cpu.maps_s,
+                             cpu.divergence_s, cpu.summary_s};
+    double sum = 0.0;
+    for (const double s : stages) {
+      EXPECT_GE(s, 0.0);
+      sum += s;
+    }
+    EXPECT_GT(cpu.ground_truth_s, 0.0);
+    EXPECT_LE(sum, cpu.total_s);
+    if (points == 0) {
+      EXPECT_EQ(cpu.divergence_s, 0.0);
+    } else {
+      EXPECT_GT(cpu.divergence_s, 0.0);
+    }
+  }
+}
+
 TEST(EvaluateTest, BadInputsNameTheFileAndWriteNothing) {
   const std::string dir = FreshDir("evaluate_bad") + "/run";
   RunRoom(dir, 1);
