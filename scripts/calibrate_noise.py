@@ -147,6 +147,7 @@ def read_steps(run, offset):
         d, dth, lateral = axle_increment(*true0, *true1, offset)
         d_odom, dth_odom, _ = axle_increment(*odom0, *odom1, offset)
         steps.append({"dt": dt, "v": v, "w": w, "dv": abs(v - v_prev), "dw": abs(w - w_prev),
+                      "on_the_spot": v == 0.0 and v_prev == 0.0, "w_change": w - w_prev,
                       "d": d, "dth": dth, "lateral": lateral,
                       "d_odom": d_odom, "dth_odom": dth_odom})
     # The change of the command one row earlier (zero at the first step).
@@ -400,9 +401,33 @@ def fit_skid(steps):
     return c, math.sqrt(residual2 / turned2)
 
 
-def fit_slip_by_regime(steps, c, gain_v):
+def sideways_residual(s, c, shift=0.0):
+    """What the skid c and, on the spot, the shift (metres per rad/s of the
+    change of the turn-rate command) leave of the axle's sideways motion."""
+    r = s["lateral"] - c * (-s["d"] * s["dth"] / s["dt"])
+    if s["on_the_spot"]:
+        r -= shift * s["w_change"]
+    return r
+
+
+def fit_shift_on_the_spot(steps, c):
+    """The mean sideways shift at a change of the turn-rate command on the
+    spot (--shift-on-the-spot; slam.ekf.lateral_shift_m_per_radps_change):
+    by least squares, r = shift (w - w_prev) over the steps whose command and
+    the one before have v = 0 and whose turn-rate command changed (r: what
+    the skid leaves, sideways_residual)."""
+    rows = [(s["w_change"], sideways_residual(s, c)) for s in steps
+            if s["on_the_spot"] and s["w_change"] != 0.0]
+    sxx = sum(x * x for x, _ in rows)
+    if sxx == 0.0:
+        raise ValueError("no change of the turn rate on the spot: the shift is undetermined")
+    return sum(x * y for x, y in rows) / sxx
+
+
+def fit_slip_by_regime(steps, c, gain_v, shift=0.0):
     """(k0, k1, kc): the sideways slip by regime (--slip-by-regime), fitted
-    by maximum likelihood to what the skid c leaves, r, modelled as a
+    by maximum likelihood to what the skid c and the shift on the spot
+    (fit_shift_on_the_spot; 0: none) leave, r, modelled as a
     zero-mean Gaussian with variance
         (k0^2 + (k1 v)^2) dth^2 + (kc |w - w_prev|)^2
     (slam.ekf.lateral_slip_std_m_per_rad, _per_rad_per_mps,
@@ -412,7 +437,7 @@ def fit_slip_by_regime(steps, c, gain_v):
     information and are left out."""
     rows = []
     for s in steps:
-        r = s["lateral"] - c * (-s["d"] * s["dth"] / s["dt"])
+        r = sideways_residual(s, c, shift)
         turn2 = s["dth"] ** 2
         if turn2 == 0.0 and s["dw"] == 0.0:
             continue
@@ -603,6 +628,10 @@ def main():
                         help="fit the sideways slip per radian turned on the spot, its growth "
                              "with the speed and its jolt at a change of the turn rate "
                              "(fit_slip_by_regime) instead of one value per radian")
+    parser.add_argument("--shift-on-the-spot", action="store_true",
+                        help="fit the mean sideways shift at a change of the turn rate on the "
+                             "spot (fit_shift_on_the_spot) and take it out of the residuals "
+                             "the slip is fitted to")
     parser.add_argument("--json", help="also write the fitted values to this JSON file")
     parser.add_argument("--consistency", metavar="WORK",
                         help="run the training sweeps in WORK and scale the noise against the "
@@ -666,7 +695,14 @@ def main():
     for name, value in zip(ODOMETRY_NAMES, odometry):
         print(f"      {name}: {value:.4g}")
     print(f"    lateral_skid_s: {c:.4g}")
-    slip = fit_slip_by_regime(steps, c, gains[0]) if args.slip_by_regime else None
+    try:
+        shift = fit_shift_on_the_spot(steps, c) if args.shift_on_the_spot else 0.0
+    except ValueError as e:
+        print(f"calibrate_noise: {e}", file=sys.stderr)
+        return 2
+    slip = fit_slip_by_regime(steps, c, gains[0], shift) if args.slip_by_regime else None
+    if args.shift_on_the_spot:
+        print(f"    lateral_shift_m_per_radps_change: {shift:.4g}")
     if slip:
         k0, k1, kc = slip
         print(f"    lateral_slip_std_m_per_rad: {k0:.4g}")
@@ -720,6 +756,8 @@ def main():
     if args.json:
         values = {"steps": len(steps), "runs": len(runs),
                   **ekf_values(gains, lag, command, odometry, c, k)}
+        if args.shift_on_the_spot:
+            values["lateral_shift_m_per_radps_change"] = shift
         if slip:
             values.update(zip(["lateral_slip_std_m_per_rad", "lateral_slip_std_m_per_rad_per_mps",
                                "lateral_slip_std_m_per_radps_change"], slip))

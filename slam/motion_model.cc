@@ -49,7 +49,8 @@ Eigen::Vector3d ApplyStep(const Eigen::Vector3d& pose_WR, double dth, const Plan
 // Eq. (6) integrated exactly: the axle centre on the arc, R moving by the
 // chord d sinc(dth/2) along the mid-arc heading and by 2 a sin(dth/2) across
 // it (h swinging about the axle), less the skid.
-PlanarStep ExactStep(double th, double d, double dth, double a_m, double skid_per_m_rad) {
+PlanarStep ExactStep(double th, double d, double dth, double a_m, double skid_per_m_rad,
+                     double shift_m) {
   const double half = 0.5 * dth;
   // sinc(half) and its derivative with respect to dth.
   double sinc, dsinc;
@@ -66,21 +67,23 @@ PlanarStep ExactStep(double th, double d, double dth, double a_m, double skid_pe
   step.forward = d * sinc;
   step.dforward_dd = sinc;
   step.dforward_ddth = d * dsinc;
-  // Sideways: the point h swinging about the axle, and the skid outward.
-  step.lateral = 2.0 * a_m * std::sin(half) - skid_per_m_rad * d * dth;
+  // Sideways: the point h swinging about the axle, the skid outward and the
+  // shift (independent of the increment).
+  step.lateral = 2.0 * a_m * std::sin(half) - skid_per_m_rad * d * dth + shift_m;
   step.dlateral_dd = -skid_per_m_rad * dth;
   step.dlateral_ddth = a_m * std::cos(half) - skid_per_m_rad * d;
   return step;
 }
 
 // The paper's forward-Euler Eq. (6): d along the start heading th, a dth
-// across it for the point h ahead of the axle, less the skid.
-PlanarStep EulerStep(double th, double d, double dth, double a_m, double skid_per_m_rad) {
+// across it for the point h ahead of the axle, less the skid, plus the shift.
+PlanarStep EulerStep(double th, double d, double dth, double a_m, double skid_per_m_rad,
+                     double shift_m) {
   PlanarStep step;
   step.phi = th;
   step.forward = d;
   step.dforward_dd = 1.0;
-  step.lateral = a_m * dth - skid_per_m_rad * d * dth;
+  step.lateral = a_m * dth - skid_per_m_rad * d * dth + shift_m;
   step.dlateral_dd = -skid_per_m_rad * dth;
   step.dlateral_ddth = a_m - skid_per_m_rad * d;
   return step;
@@ -90,12 +93,14 @@ PlanarStep EulerStep(double th, double d, double dth, double a_m, double skid_pe
 
 Eigen::Vector3d PredictPose(const Eigen::Vector3d& pose_WR, const Eigen::Vector2d& increment,
                             double a_m, Eigen::Matrix3d* A, Eigen::Matrix<double, 3, 2>* W,
-                            double skid_per_m_rad, MotionIntegration integration) {
+                            double skid_per_m_rad, MotionIntegration integration,
+                            double lateral_shift_m) {
   const double d = increment.x();
   const double dth = increment.y();
-  const PlanarStep step = integration == MotionIntegration::kEuler
-                              ? EulerStep(pose_WR.z(), d, dth, a_m, skid_per_m_rad)
-                              : ExactStep(pose_WR.z(), d, dth, a_m, skid_per_m_rad);
+  const PlanarStep step =
+      integration == MotionIntegration::kEuler
+          ? EulerStep(pose_WR.z(), d, dth, a_m, skid_per_m_rad, lateral_shift_m)
+          : ExactStep(pose_WR.z(), d, dth, a_m, skid_per_m_rad, lateral_shift_m);
   return ApplyStep(pose_WR, dth, step, A, W);
 }
 

@@ -24,6 +24,11 @@ struct MotionInput {
   /// R moves by -skid d dth across the mid-arc heading (EkfParams::lateral_skid_s
   /// divided by dt). 0: Eq. (6) alone.
   double skid_per_m_rad = 0.0;
+  /// Mean sideways shift of R over the step, metres across the mid-arc
+  /// heading (positive: to the left), independent of `increment`: the
+  /// sideways motion of a robot turning on the spot when its turn rate
+  /// changes (EkfParams::lateral_shift_m_per_radps_change). 0: none.
+  double lateral_shift_m = 0.0;
   /// How Eq. (6) is integrated over the step (EkfParams::motion_integration).
   MotionIntegration integration = MotionIntegration::kExact;
 };
@@ -35,15 +40,17 @@ struct MotionInput {
 ///   th' = wrap(th + dth),
 /// integrated exactly (kExact: the axle centre on an arc, docs/method.md
 /// departure 9), plus a skid of -skid_per_m_rad d dth across the mid-arc
-/// heading (MotionInput::skid_per_m_rad); or, with kEuler, the forward-Euler
-/// step above as the paper writes it, the skid then across the start heading
-/// th. If not null, `A` receives d pose' / d pose and `W` d pose' / d
+/// heading (MotionInput::skid_per_m_rad) and a shift of `lateral_shift_m`
+/// across it (MotionInput::lateral_shift_m); or, with kEuler, the
+/// forward-Euler step above as the paper writes it, the skid and the shift
+/// then across the start heading th. If not null, `A` receives d pose' / d pose and `W` d pose' / d
 /// increment, of the integration chosen.
 Eigen::Vector3d PredictPose(const Eigen::Vector3d& pose_WR, const Eigen::Vector2d& increment,
                             double a_m, Eigen::Matrix3d* A = nullptr,
                             Eigen::Matrix<double, 3, 2>* W = nullptr,
                             double skid_per_m_rad = 0.0,
-                            MotionIntegration integration = MotionIntegration::kExact);
+                            MotionIntegration integration = MotionIntegration::kExact,
+                            double lateral_shift_m = 0.0);
 
 /// The speeds the robot moves at over a step of `dt_s` (>= 0) when it
 /// follows `command` through a first-order lag of time constant `lag_s`

@@ -205,6 +205,15 @@ struct EkfParams {
   /// that starts or stops turning jolts sideways). 0 (the default): none
   /// (docs/method.md, departure 23).
   double lateral_slip_std_m_per_radps_change = 0.0;
+  /// Mean sideways shift of R at a change of the turn-rate command while the
+  /// robot turns on the spot, metres per rad/s of change (signed), with the
+  /// command input only: when the command and the one of the record before
+  /// both have v = 0, the prediction moves R by this (w - w_previous) across
+  /// the mid-arc heading, to the left for a positive value and an increase
+  /// of w (the robot's mass, off the axle, pushes the wheels sideways as the
+  /// turn accelerates; the same in every run, so a mean, not a spread). 0
+  /// (the default): none (docs/method.md, departure 24).
+  double lateral_shift_m_per_radps_change = 0.0;
   /// Sideways skid of the axle centre in turns, seconds: Eq. (6) has no
   /// sideways motion, but tyres skid to the outside of a turn at a speed
   /// proportional to the centripetal acceleration, c v w. The prediction
@@ -309,6 +318,7 @@ struct EkfParams {
     a->Visit(MJSLAM_NVP(lateral_slip_std_m_per_rad));
     a->Visit(MJSLAM_NVP(lateral_slip_std_m_per_rad_per_mps));
     a->Visit(MJSLAM_NVP(lateral_slip_std_m_per_radps_change));
+    a->Visit(MJSLAM_NVP(lateral_shift_m_per_radps_change));
     a->Visit(MJSLAM_NVP(lateral_skid_s));
     a->Visit(MJSLAM_NVP(jacobians));
     a->Visit(MJSLAM_NVP(initial_position_std_m));

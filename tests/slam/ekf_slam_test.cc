@@ -290,6 +290,60 @@ TEST(EkfSlamTest, SlipAtAChangeOfTheTurnRate) {
   EXPECT_NEAR(PositionVarianceAfter(params, {{0.0, 0.5}, {0.0, 0.0}}), 0.0, 1e-18);
 }
 
+Pose2 PoseAfter(const EkfParams& params, const std::vector<Twist2>& commands) {
+  EkfSlam filter(params, CorrectionMode::kClassical, Pose2(1.0, 2.0, 0.3), Pose2());
+  SensorRecord record;
+  record.dt_s = 0.1;
+  for (const Twist2& command : commands) {
+    record.command = command;
+    filter.Step(record, nullptr);
+  }
+  return filter.X_WR();
+}
+
+TEST(EkfSlamTest, ShiftAtAChangeOfTheTurnRateOnTheSpot) {
+  EkfParams params = SlipOnlyParams();
+  params.lateral_slip_std_m_per_rad = 0.0;
+  EkfParams shifted = params;
+  shifted.lateral_shift_m_per_radps_change = 0.001;
+  // On the spot from rest at 0.5 rad/s, held, stopped (0.05 rad a step from
+  // heading 0.3): +0.5 mm across the first step's mid-arc heading 0.325,
+  // nothing in the held step, -0.5 mm across the last one's, 0.4.
+  const std::vector<Twist2> spot = {{0.0, 0.5}, {0.0, 0.5}, {0.0, 0.0}};
+  const Pose2 plain = PoseAfter(params, spot);
+  const Pose2 moved = PoseAfter(shifted, spot);
+  const Eigen::Vector2d expected =
+      0.0005 * Eigen::Vector2d(-std::sin(0.325), std::cos(0.325)) -
+      0.0005 * Eigen::Vector2d(-std::sin(0.4), std::cos(0.4));
+  EXPECT_NEAR(moved.x - plain.x, expected.x(), 1e-15);
+  EXPECT_NEAR(moved.y - plain.y, expected.y(), 1e-15);
+  EXPECT_EQ(moved.theta, plain.theta);
+  // Stopping at once (heading 0.35, no turn): the -0.5 mm across 0.35.
+  const Pose2 stopping = PoseAfter(shifted, {{0.0, 0.5}, {0.0, 0.0}});
+  const Pose2 stopping_plain = PoseAfter(params, {{0.0, 0.5}, {0.0, 0.0}});
+  const Eigen::Vector2d expected_stopping =
+      0.0005 * Eigen::Vector2d(-std::sin(0.325), std::cos(0.325)) -
+      0.0005 * Eigen::Vector2d(-std::sin(0.35), std::cos(0.35));
+  EXPECT_NEAR(stopping.x - stopping_plain.x, expected_stopping.x(), 1e-15);
+  EXPECT_NEAR(stopping.y - stopping_plain.y, expected_stopping.y(), 1e-15);
+  // Not while driving, nor in the step that stops or starts the driving.
+  for (const std::vector<Twist2>& driving :
+       {std::vector<Twist2>{{0.5, 0.5}, {0.5, 0.0}}, std::vector<Twist2>{{0.5, 0.0}, {0.0, 0.5}},
+        std::vector<Twist2>{{0.0, 0.5}, {0.5, 0.0}}}) {
+    const Pose2 a = PoseAfter(shifted, driving);
+    const Pose2 b = PoseAfter(params, driving);
+    const double first_shift = driving[0].v_mps == 0.0 ? 0.0005 : 0.0;  // from rest, on the spot
+    EXPECT_NEAR(std::hypot(a.x - b.x, a.y - b.y), first_shift, 1e-15);
+  }
+  // With odometry the command's change is not the robot's: no shift.
+  params.input = shifted.input = "odometry";
+  params.odometry_noise = shifted.odometry_noise = OdometryNoiseParams{0.0, 0.0, 0.0, 0.0, 0.0};
+  const Pose2 a = PoseAfter(shifted, spot);
+  const Pose2 b = PoseAfter(params, spot);
+  EXPECT_EQ(a.x, b.x);
+  EXPECT_EQ(a.y, b.y);
+}
+
 TEST(EkfSlamTest, PredictsFromOdometry) {
   // Odometry generated with Eq. (6)'s own kinematics, (d, a dth, dth) per
   // record in the previous R frame: without skid, the filter must reproduce
