@@ -64,6 +64,7 @@ TEST(EkfParamsTest, DefaultsAreValidAndBadValuesAreNamed) {
   params.command_noise.v_noise_fraction = -1.0;
   params.lateral_slip_std_m_per_rad_per_mps = -0.1;
   params.lateral_slip_std_m_per_radps_change = -0.1;
+  params.lateral_shift_m_per_radps_change = std::numeric_limits<double>::infinity();
   const std::vector<ParamProblem> problems = params.Validate();
   std::string keys;
   for (const ParamProblem& problem : problems) keys += problem.key + " ";
@@ -75,7 +76,12 @@ TEST(EkfParamsTest, DefaultsAreValidAndBadValuesAreNamed) {
   EXPECT_NE(keys.find("command_noise.v_noise_fraction"), std::string::npos) << keys;
   EXPECT_NE(keys.find("lateral_slip_std_m_per_rad_per_mps"), std::string::npos) << keys;
   EXPECT_NE(keys.find("lateral_slip_std_m_per_radps_change"), std::string::npos) << keys;
+  EXPECT_NE(keys.find("lateral_shift_m_per_radps_change"), std::string::npos) << keys;
   EXPECT_THROW(params.ValidateOrThrow(), ParamError);
+  // The shift is signed: a negative value is valid.
+  EkfParams left;
+  left.lateral_shift_m_per_radps_change = -1e-4;
+  EXPECT_TRUE(left.Validate().empty());
 }
 
 TEST(EkfParamsTest, MotionIntegrationAndSelectionPolicyAreNamedChoices) {
