@@ -1,11 +1,11 @@
 #!/usr/bin/python3
 """Calibrates the filters' process model from the true motion of runs: the
 values of slam.ekf.command_gain_v, _w, slam.ekf.command_noise.*, slam.ekf.odometry_noise.*,
-slam.ekf.lateral_skid_s and slam.ekf.lateral_slip_std_m_per_rad
-(docs/method.md, "Calibrating the process noise").
+slam.ekf.lateral_skid_s, slam.ekf.lateral_slip_std_m_per_rad (and by regime) and
+slam.ekf.lateral_shift_m_per_radps_change (docs/method.md, "Calibrating the process noise").
 
     scripts/calibrate_noise.py DIR [DIR ...] [--offset A] [--window L] [--no-gain] [--no-lag]
-                               [--slip-by-regime] [--json FILE]
+                               [--slip-by-regime] [--shift-on-the-spot] [--json FILE]
     scripts/calibrate_noise.py --consistency WORK --write CONFIG [--config BASE] [--seed S]
                                [--runs N] [--jobs J] [--iterations K] [--tolerance T]
 
@@ -53,6 +53,11 @@ an arc along the mid-arc heading, plus a sideways skid):
   the speed and the slip at a change of the turn rate
   (lateral_slip_std_m_per_rad, _per_rad_per_mps, _per_radps_change;
   docs/method.md, departure 23), by maximum likelihood (fit_slip_by_regime).
+  With --shift-on-the-spot, first the mean sideways shift at a change of the
+  turn-rate command on the spot (the command and the one before with v = 0),
+  r = shift (w - w_prev), by least squares (lateral_shift_m_per_radps_change,
+  departure 24; fit_shift_on_the_spot), taken out of what the slip is
+  fitted to.
 
 Prints the fitted values as the YAML of configs/default.yaml's slam.ekf
 section, and for each fit the mean of (error / sigma)^2 (1 for a model that
