@@ -2,10 +2,10 @@
 """Calibrates the filters' process model from the true motion of runs: the
 values of slam.ekf.command_gain_v, _w, slam.ekf.command_noise.*, slam.ekf.odometry_noise.*,
 slam.ekf.lateral_skid_s, slam.ekf.lateral_slip_std_m_per_rad (and by regime) and
-slam.ekf.lateral_shift_m_per_radps_change (docs/method.md, "Calibrating the process noise").
+slam.ekf.turn_centre_offset_m_per_radps (docs/method.md, "Calibrating the process noise").
 
     scripts/calibrate_noise.py DIR [DIR ...] [--offset A] [--window L] [--no-gain] [--no-lag]
-                               [--slip-by-regime] [--shift-on-the-spot] [--json FILE]
+                               [--slip-by-regime] [--turn-centre] [--json FILE]
     scripts/calibrate_noise.py --consistency WORK --write CONFIG [--config BASE] [--seed S]
                                [--runs N] [--jobs J] [--iterations K] [--tolerance T]
 
@@ -53,11 +53,17 @@ an arc along the mid-arc heading, plus a sideways skid):
   the speed and the slip at a change of the turn rate
   (lateral_slip_std_m_per_rad, _per_rad_per_mps, _per_radps_change;
   docs/method.md, departure 23), by maximum likelihood (fit_slip_by_regime).
-  With --shift-on-the-spot, first the mean sideways shift at a change of the
-  turn-rate command on the spot (the command and the one before with v = 0),
-  r = shift (w - w_prev), by least squares (lateral_shift_m_per_radps_change,
-  departure 24; fit_shift_on_the_spot), taken out of what the slip is
-  fitted to.
+- turn centre (--turn-centre): on the spot (the command and the one before
+  with v = 0) the robot turns about a point s w beside its axle
+  (turn_centre_offset_m_per_radps, departure 24; slam::TurnCentre): the axle
+  moves by s (w n(th') - w_prev n(th)), -s (w + w_prev) sin(dth/2) along the
+  mid-arc heading and s (w - w_prev) cos(dth/2) across it (w, w_prev the
+  turn-rate commands of rows k-1 and k-2, dth the true turn). s is fitted
+  first (after the lag), by least squares of both components together
+  (fit_turn_centre; the fits of each alone are printed too), and this mean
+  motion is taken out of the true steps before everything else is fitted to
+  them: the gains, the command noise and the sideways slip are those of the
+  residuals.
 
 Prints the fitted values as the YAML of configs/default.yaml's slam.ekf
 section, and for each fit the mean of (error / sigma)^2 (1 for a model that
@@ -152,7 +158,7 @@ def read_steps(run, offset):
         d, dth, lateral = axle_increment(*true0, *true1, offset)
         d_odom, dth_odom, _ = axle_increment(*odom0, *odom1, offset)
         steps.append({"dt": dt, "v": v, "w": w, "dv": abs(v - v_prev), "dw": abs(w - w_prev),
-                      "on_the_spot": v == 0.0 and v_prev == 0.0, "w_change": w - w_prev,
+                      "on_the_spot": v == 0.0 and v_prev == 0.0, "w_prev": w_prev,
                       "d": d, "dth": dth, "lateral": lateral,
                       "d_odom": d_odom, "dth_odom": dth_odom})
     # The change of the command one row earlier (zero at the first step).
@@ -406,33 +412,72 @@ def fit_skid(steps):
     return c, math.sqrt(residual2 / turned2)
 
 
-def sideways_residual(s, c, shift=0.0):
-    """What the skid c and, on the spot, the shift (metres per rad/s of the
-    change of the turn-rate command) leave of the axle's sideways motion."""
-    r = s["lateral"] - c * (-s["d"] * s["dth"] / s["dt"])
-    if s["on_the_spot"]:
-        r -= shift * s["w_change"]
-    return r
+def sideways_residual(s, c):
+    """What the skid c leaves of the axle's sideways motion."""
+    return s["lateral"] - c * (-s["d"] * s["dth"] / s["dt"])
 
 
-def fit_shift_on_the_spot(steps, c):
-    """The mean sideways shift at a change of the turn-rate command on the
-    spot (--shift-on-the-spot; slam.ekf.lateral_shift_m_per_radps_change):
-    by least squares, r = shift (w - w_prev) over the steps whose command and
-    the one before have v = 0 and whose turn-rate command changed (r: what
-    the skid leaves, sideways_residual)."""
-    rows = [(s["w_change"], sideways_residual(s, c)) for s in steps
-            if s["on_the_spot"] and s["w_change"] != 0.0]
-    sxx = sum(x * x for x, _ in rows)
-    if sxx == 0.0:
-        raise ValueError("no change of the turn rate on the spot: the shift is undetermined")
-    return sum(x * y for x, y in rows) / sxx
+def turn_centre_regressors(s):
+    """(along, across): the axle's motion over step s, along and across the
+    mid-arc heading, per metre per rad/s of the turn centre's offset (zero
+    off the spot): -(w + w_prev) sin(dth/2) and (w - w_prev) cos(dth/2)."""
+    if not s["on_the_spot"]:
+        return 0.0, 0.0
+    half = 0.5 * s["dth"]
+    return -(s["w"] + s["w_prev"]) * math.sin(half), (s["w"] - s["w_prev"]) * math.cos(half)
 
 
-def fit_slip_by_regime(steps, c, gain_v, shift=0.0):
+def fit_turn_centre(steps, c):
+    """(s, s_along, s_across): the turn centre's offset per rad/s
+    (--turn-centre; slam.ekf.turn_centre_offset_m_per_radps) from the axle's
+    motion on the spot along and across the mid-arc heading
+    (turn_centre_regressors): s_along and s_across by least squares of each
+    component alone, s by weighted least squares of both together, each
+    component weighted by the inverse of its mean squared residual from its
+    own fit (the along component carries the wheels' forward noise, tens of
+    micrometres a step, the across one a few). Along: the chord less the chord
+    of the followed speed (apply_lag first); across: what the skid c leaves
+    (sideways_residual)."""
+    rows = {"along": [], "across": []}
+    for s in steps:
+        if not s["on_the_spot"]:
+            continue
+        x_along, x_across = turn_centre_regressors(s)
+        half = 0.5 * s["dth"]
+        sinc = 1.0 - half * half / 6.0 if abs(half) < 1e-4 else math.sin(half) / half
+        rows["along"].append((x_along, (s["d"] - s["fv"] * s["dt"]) * sinc))
+        rows["across"].append((x_across, sideways_residual(s, c)))
+    alone = {}
+    weighted_xx = weighted_xy = 0.0
+    for key, pairs in rows.items():
+        sxx = sum(x * x for x, _ in pairs)
+        if sxx == 0.0:
+            raise ValueError("no turn and no change of the turn rate on the spot: the turn "
+                             "centre is undetermined")
+        alone[key] = sum(x * y for x, y in pairs) / sxx
+        mean_square = sum((y - alone[key] * x) ** 2 for x, y in pairs) / len(pairs)
+        weight = 1.0 / max(mean_square, 1e-300)
+        weighted_xx += weight * sxx
+        weighted_xy += weight * alone[key] * sxx
+    return weighted_xy / weighted_xx, alone["along"], alone["across"]
+
+
+def take_out_turn_centre(steps, offset):
+    """Takes the turn about the point `offset` w beside the axle out of the
+    true steps (d, lateral), so that what follows is fitted to the rest."""
+    for s in steps:
+        x_along, x_across = turn_centre_regressors(s)
+        if x_along == 0.0 and x_across == 0.0:
+            continue
+        half = 0.5 * s["dth"]
+        sinc = 1.0 - half * half / 6.0 if abs(half) < 1e-4 else math.sin(half) / half
+        s["d"] -= offset * x_along / sinc
+        s["lateral"] -= offset * x_across
+
+
+def fit_slip_by_regime(steps, c, gain_v):
     """(k0, k1, kc): the sideways slip by regime (--slip-by-regime), fitted
-    by maximum likelihood to what the skid c and the shift on the spot
-    (fit_shift_on_the_spot; 0: none) leave, r, modelled as a
+    by maximum likelihood to what the skid c leaves, r, modelled as a
     zero-mean Gaussian with variance
         (k0^2 + (k1 v)^2) dth^2 + (kc |w - w_prev|)^2
     (slam.ekf.lateral_slip_std_m_per_rad, _per_rad_per_mps,
@@ -442,7 +487,7 @@ def fit_slip_by_regime(steps, c, gain_v, shift=0.0):
     information and are left out."""
     rows = []
     for s in steps:
-        r = sideways_residual(s, c, shift)
+        r = sideways_residual(s, c)
         turn2 = s["dth"] ** 2
         if turn2 == 0.0 and s["dw"] == 0.0:
             continue
@@ -633,9 +678,9 @@ def main():
                         help="fit the sideways slip per radian turned on the spot, its growth "
                              "with the speed and its jolt at a change of the turn rate "
                              "(fit_slip_by_regime) instead of one value per radian")
-    parser.add_argument("--shift-on-the-spot", action="store_true",
-                        help="fit the mean sideways shift at a change of the turn rate on the "
-                             "spot (fit_shift_on_the_spot) and take it out of the residuals "
+    parser.add_argument("--turn-centre", action="store_true",
+                        help="fit the point beside the axle the robot turns about on the spot "
+                             "(fit_turn_centre) and take its motion out of the true steps "
                              "the slip is fitted to")
     parser.add_argument("--json", help="also write the fitted values to this JSON file")
     parser.add_argument("--consistency", metavar="WORK",
@@ -685,8 +730,19 @@ def main():
         return 2
     lag = 0.0 if args.no_lag else fit_lag(runs_steps)
     apply_lag(runs_steps, lag)
-    command, gains = fit_command(runs_steps, args.window, not args.no_gain)
+    # The odometry against the true steps as they are (the turn centre is a
+    # model of the command input only).
     odometry = fit_odometry(steps)
+    turn_centre = None
+    if args.turn_centre:
+        try:
+            turn_centre = fit_turn_centre(steps, c)
+        except ValueError as e:
+            print(f"calibrate_noise: {e}", file=sys.stderr)
+            return 2
+        take_out_turn_centre(steps, turn_centre[0])
+        c, k = fit_skid(steps)
+    command, gains = fit_command(runs_steps, args.window, not args.no_gain)
 
     print(f"# scripts/calibrate_noise.py: {len(steps)} steps from {len(runs)} runs")
     print("slam:\n  ekf:")
@@ -700,14 +756,10 @@ def main():
     for name, value in zip(ODOMETRY_NAMES, odometry):
         print(f"      {name}: {value:.4g}")
     print(f"    lateral_skid_s: {c:.4g}")
-    try:
-        shift = fit_shift_on_the_spot(steps, c) if args.shift_on_the_spot else 0.0
-    except ValueError as e:
-        print(f"calibrate_noise: {e}", file=sys.stderr)
-        return 2
-    slip = fit_slip_by_regime(steps, c, gains[0], shift) if args.slip_by_regime else None
-    if args.shift_on_the_spot:
-        print(f"    lateral_shift_m_per_radps_change: {shift:.4g}")
+    slip = fit_slip_by_regime(steps, c, gains[0]) if args.slip_by_regime else None
+    if turn_centre:
+        print(f"    turn_centre_offset_m_per_radps: {turn_centre[0]:.4g}   # along alone "
+              f"{turn_centre[1]:.4g}, across alone {turn_centre[2]:.4g}")
     if slip:
         k0, k1, kc = slip
         print(f"    lateral_slip_std_m_per_rad: {k0:.4g}")
@@ -746,6 +798,11 @@ def main():
     print_bins("command v", steps, "dv", [0, 1e-9, 0.05, 0.15, 0.3, 10], nv)
     print_bins("command w", steps, "|w|", [0, 0.05, 0.3, 0.8, 1.5, 10], nw)
     print_bins("command w", steps, "dw", [0, 1e-9, 0.1, 0.3, 0.8, 10], nw)
+    spinning = [s for s in steps if s["on_the_spot"] and s["w"] != 0.0]
+    if spinning:
+        print(f"  on the spot, turning: {len(spinning)} steps, mean (e/sigma)^2 = "
+              f"{sum(nv(s) for s in spinning) / len(spinning):.2f} (v), "
+              f"{sum(nw(s) for s in spinning) / len(spinning):.2f} (w)")
 
     def nd(s):
         return (s["d_odom"] - s["d"]) ** 2 / odometry_variances(s, odometry)[0]
@@ -761,8 +818,10 @@ def main():
     if args.json:
         values = {"steps": len(steps), "runs": len(runs),
                   **ekf_values(gains, lag, command, odometry, c, k)}
-        if args.shift_on_the_spot:
-            values["lateral_shift_m_per_radps_change"] = shift
+        if turn_centre:
+            values["turn_centre_offset_m_per_radps"] = turn_centre[0]
+            values["turn_centre_offset_along_alone"] = turn_centre[1]
+            values["turn_centre_offset_across_alone"] = turn_centre[2]
         if slip:
             values.update(zip(["lateral_slip_std_m_per_rad", "lateral_slip_std_m_per_rad_per_mps",
                                "lateral_slip_std_m_per_radps_change"], slip))

@@ -81,9 +81,8 @@ std::vector<ParamProblem> EkfParams::Validate() const {
   check.NonNegative("lateral_slip_std_m_per_rad", lateral_slip_std_m_per_rad);
   check.NonNegative("lateral_slip_std_m_per_rad_per_mps", lateral_slip_std_m_per_rad_per_mps);
   check.NonNegative("lateral_slip_std_m_per_radps_change", lateral_slip_std_m_per_radps_change);
-  check.Require(std::isfinite(lateral_shift_m_per_radps_change),
-                "lateral_shift_m_per_radps_change", lateral_shift_m_per_radps_change,
-                "a finite value");
+  check.Require(std::isfinite(turn_centre_offset_m_per_radps), "turn_centre_offset_m_per_radps",
+                turn_centre_offset_m_per_radps, "a finite value");
   check.NonNegative("lateral_skid_s", lateral_skid_s);
   check.OneOf("jacobians", jacobians,
               std::vector<std::string>(std::begin(kJacobianPointNames),

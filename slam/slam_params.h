@@ -205,15 +205,19 @@ struct EkfParams {
   /// that starts or stops turning jolts sideways). 0 (the default): none
   /// (docs/method.md, departure 23).
   double lateral_slip_std_m_per_radps_change = 0.0;
-  /// Mean sideways shift of R at a change of the turn-rate command while the
-  /// robot turns on the spot, metres per rad/s of change (signed), with the
-  /// command input only: when the command and the one of the record before
-  /// both have v = 0, the prediction moves R by this (w - w_previous) across
-  /// the mid-arc heading, to the left for a positive value and an increase
-  /// of w (the robot's mass, off the axle, pushes the wheels sideways as the
-  /// turn accelerates; the same in every run, so a mean, not a spread). 0
-  /// (the default): none (docs/method.md, departure 24).
-  double lateral_shift_m_per_radps_change = 0.0;
+  /// The point a robot turning on the spot turns about, beside its axle,
+  /// metres per rad/s of the commanded turn rate (signed), with the command
+  /// input only: when the command and the one of the record before both
+  /// have v = 0, the axle lies this times w to the left of the point it
+  /// turns about (for a positive value and w > 0: the point on the right, the
+  /// outside of the turn), the point fixed in W over the step
+  /// (slam::TurnCentre). Its two consequences: a sideways shift of the axle
+  /// by this (w - w_previous) when the turn rate changes and, while it is
+  /// held, the axle circling the point (for a positive value a backward
+  /// creep of about this w^2 dt per step). The same in every run, so a mean
+  /// motion, not a spread. 0 (the default): the turn about the axle
+  /// (docs/method.md, departure 24).
+  double turn_centre_offset_m_per_radps = 0.0;
   /// Sideways skid of the axle centre in turns, seconds: Eq. (6) has no
   /// sideways motion, but tyres skid to the outside of a turn at a speed
   /// proportional to the centripetal acceleration, c v w. The prediction
@@ -318,7 +322,7 @@ struct EkfParams {
     a->Visit(MJSLAM_NVP(lateral_slip_std_m_per_rad));
     a->Visit(MJSLAM_NVP(lateral_slip_std_m_per_rad_per_mps));
     a->Visit(MJSLAM_NVP(lateral_slip_std_m_per_radps_change));
-    a->Visit(MJSLAM_NVP(lateral_shift_m_per_radps_change));
+    a->Visit(MJSLAM_NVP(turn_centre_offset_m_per_radps));
     a->Visit(MJSLAM_NVP(lateral_skid_s));
     a->Visit(MJSLAM_NVP(jacobians));
     a->Visit(MJSLAM_NVP(initial_position_std_m));

@@ -1,7 +1,7 @@
 #!/usr/bin/python3
 """Test of scripts/calibrate_noise.py's command-following fit: it must recover the gains, the
-lag, the settling wheels' noise, the sideways slip by regime and the sideways shift on the spot
-of a robot made with known ones.
+lag, the settling wheels' noise, the sideways slip by regime and the point beside the axle a
+robot turning on the spot turns about, of a robot made with known ones.
 
     /usr/bin/python3 tests/integration/calibrate_noise_test.py SOURCE_DIR
 
@@ -13,15 +13,17 @@ the robot at rest before the first row; the point R 0.2 m ahead of the axle, as 
 assumes. The axle also slips sideways (across the mid-arc heading) by a zero-mean Gaussian of
 variance (K0^2 + (K1 v)^2) dth^2 + (KC |w - w_prev|)^2 (slam.ekf.lateral_slip_std_m_per_rad,
 _per_rad_per_mps, _per_radps_change; v the speed the filter predicts with; its own random
-stream), fitted with --slip-by-regime, and, when the command and the one before have v = 0, by
-a mean shift of KS (w - w_prev) (slam.ekf.lateral_shift_m_per_radps_change), fitted with
---shift-on-the-spot. Asserted: the fitted command_lag_s within 0.005 s of 0.05, command_gain_v within 0.002
+stream), fitted with --slip-by-regime, and, when the command and the one before have v = 0, the
+axle turns about a point KS w beside it, so moves by KS (w n(th') - w_prev n(th)) (n the left
+normal; slam.ekf.turn_centre_offset_m_per_radps), fitted with --turn-centre. Asserted: the fitted command_lag_s within 0.005 s of 0.05, command_gain_v within 0.002
 of 0.99, command_gain_w within 0.005 of 1.01, settle_noise_fraction within 0.02 of 0.1, each
-slip and the shift within 20 % of its value. Shown by hand to fail: with the script's lag left at 0 (--no-lag)
+slip and the turn centre's offset (fitted from both components together and from each alone:
+the shift at a change and the creep while held) within 20 % of its value. Shown by hand to fail: with the script's lag left at 0 (--no-lag)
 the gains are still found but the test fails on the lag; with the settle term left out of the
 script's sigmas it fails on it; with the change term left out of fit_slip_by_regime's variance
-it fails on the slips; with the shift not taken out of the residuals (sideways_residual) it
-fails on the change's slip (0.00185 for 0.0005), and with no shift fitted on the shift too.
+it fails on the slips; with the turn centre's motion not taken out of the true steps
+(take_out_turn_centre) it fails on the change's slip, and with the creep (the along
+component) left out of fit_turn_centre on the offset along alone.
 
 Exit status 0 when the values are recovered, 1 with the reasons otherwise.
 """
@@ -44,7 +46,7 @@ DT = 0.1
 K0 = 2e-4   # m/rad
 K1 = 2e-3   # m/rad per m/s
 KC = 5e-4   # m per rad/s
-KS = 4e-3   # m per rad/s, on the spot (19 such changes in the 3 runs: standard error 4.5 %)
+KS = 4e-3   # m per rad/s, on the spot
 
 
 def write_run(directory, seed):
@@ -76,8 +78,8 @@ def write_run(directory, seed):
             dth = (GAIN_W * fw + rng.gauss(0, 0.005 + SETTLE * settle[1])) * DT
             lateral = slip_rng.gauss(0, math.sqrt((K0 ** 2 + (K1 * GAIN_V * fv) ** 2) * dth ** 2
                                                   + (KC * abs(w - previous[1])) ** 2))
-            if v == 0.0 and previous[0] == 0.0:
-                lateral += KS * (w - previous[1])
+            on_the_spot = v == 0.0 and previous[0] == 0.0
+            w_prev = previous[1]
             settle = [abs(v - previous[0]), abs(w - previous[1])]
             previous = [v, w]
             half = 0.5 * dth
@@ -86,6 +88,9 @@ def write_run(directory, seed):
             y += chord * math.sin(th + half)
             x -= lateral * math.sin(th + half)
             y += lateral * math.cos(th + half)
+            if on_the_spot:  # the axle about the point KS w beside it
+                x += KS * (-w * math.sin(th + dth) + w_prev * math.sin(th))
+                y += KS * (w * math.cos(th + dth) - w_prev * math.cos(th))
             th = math.remainder(th + dth, 2.0 * math.pi)
 
 
@@ -99,7 +104,7 @@ def main(source_dir):
         fitted = os.path.join(out, "fit.json")
         result = subprocess.run(["/usr/bin/python3",
                                  os.path.join(source_dir, "scripts", "calibrate_noise.py"),
-                                 *runs, "--offset", str(OFFSET), "--slip-by-regime", "--shift-on-the-spot",
+                                 *runs, "--offset", str(OFFSET), "--slip-by-regime", "--turn-centre",
                                  "--json", fitted]
                                 + sys.argv[2:], capture_output=True, text=True)
         if result.returncode != 0:
@@ -113,13 +118,17 @@ def main(source_dir):
               f"{values['command_noise']['settle_noise_fraction']:.4f} ({SETTLE})")
         print(f"fitted slips: {values['lateral_slip_std_m_per_rad']:.3g} ({K0}), "
               f"{values['lateral_slip_std_m_per_rad_per_mps']:.3g} ({K1}), "
-              f"{values['lateral_slip_std_m_per_radps_change']:.3g} ({KC}), shift "
-              f"{values['lateral_shift_m_per_radps_change']:.3g} ({KS})")
+              f"{values['lateral_slip_std_m_per_radps_change']:.3g} ({KC}), turn centre "
+              f"{values['turn_centre_offset_m_per_radps']:.3g} (along alone "
+              f"{values['turn_centre_offset_along_alone']:.3g}, across alone "
+              f"{values['turn_centre_offset_across_alone']:.3g}; {KS})")
         problems = []
         for key, made in (("lateral_slip_std_m_per_rad", K0),
                           ("lateral_slip_std_m_per_rad_per_mps", K1),
                           ("lateral_slip_std_m_per_radps_change", KC),
-                          ("lateral_shift_m_per_radps_change", KS)):
+                          ("turn_centre_offset_m_per_radps", KS),
+                          ("turn_centre_offset_along_alone", KS),
+                          ("turn_centre_offset_across_alone", KS)):
             if abs(values[key] / made - 1.0) > 0.2:
                 problems.append(f"{key}: fitted {values[key]:.4g}, made {made} (tolerance 20 %)")
         for key, made, tolerance in (("command_lag_s", TAU, 0.005),

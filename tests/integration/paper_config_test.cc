@@ -25,7 +25,7 @@ void ExpectPaperChoices(const app::RunConfig& config) {
   EXPECT_EQ(ekf.lateral_slip_std_m_per_rad, 0.0);
   EXPECT_EQ(ekf.lateral_slip_std_m_per_rad_per_mps, 0.0);
   EXPECT_EQ(ekf.lateral_slip_std_m_per_radps_change, 0.0);
-  EXPECT_EQ(ekf.lateral_shift_m_per_radps_change, 0.0);
+  EXPECT_EQ(ekf.turn_centre_offset_m_per_radps, 0.0);
   EXPECT_EQ(ekf.lateral_skid_s, 0.0);
   EXPECT_TRUE(ekf.correct_corners_of_matched_lines);
   EXPECT_FALSE(ekf.corners_from_map_lines);
