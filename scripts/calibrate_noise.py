@@ -25,7 +25,8 @@ an arc along the mid-arc heading, plus a sideways skid):
   by the gains g_v and g_w (slam.ekf.command_gain_v, _w: the
   robot's mean speed over its command), its noise growing with the change
   from the command of row k-2 and with the change one row earlier (row k-2
-  from row k-3: the wheels still settling). The errors e_v = d / dt - g_v v_f and
+  from row k-3: the wheels still settling), and with --lag-noise with the gap
+  between the command and the followed speed (lag_noise_fraction). The errors e_v = d / dt - g_v v_f and
   e_w = dth / dt - g_w w_f (v_f, w_f the speeds followed) of the true increment (d, dth) are modelled as
   independent zero-mean Gaussians with
       sigma_v = v_noise_std_mps + v_noise_fraction |v_f| + change_noise_fraction |v - v_prev|
@@ -229,11 +230,14 @@ def gaussian_nll(errors_and_variances):
 
 def command_sigmas(s, p):
     """(sigma_v, sigma_w) of CommandInput for step s, p = (v0, kv, w0, kw, kc,
-    ks): ks the settle term's fraction (0 when p has five values)."""
+    ks[, kl]): ks the settle term's fraction (0 when p has five values), kl
+    the lag term's (of the gap between the command and the followed speed;
+    0 when p has six values)."""
     v0, kv, w0, kw, kc = p[:5]
     ks = p[5] if len(p) > 5 else 0.0
-    return (v0 + kv * abs(s["fv"]) + kc * s["dv"] + ks * s["dv1"],
-            w0 + kw * abs(s["fw"]) + kc * s["dw"] + ks * s["dw1"])
+    kl = p[6] if len(p) > 6 else 0.0
+    return (v0 + kv * abs(s["fv"]) + kc * s["dv"] + ks * s["dv1"] + kl * abs(s["v"] - s["fv"]),
+            w0 + kw * abs(s["fw"]) + kc * s["dw"] + ks * s["dw1"] + kl * abs(s["w"] - s["fw"]))
 
 
 def command_errors(s, gains=(1.0, 1.0)):
@@ -347,14 +351,15 @@ def window_pairs(windows, p, gains=(1.0, 1.0)):
     return pairs
 
 
-def fit_command(runs_steps, window, with_gains=True, rounds=3):
+def fit_command(runs_steps, window, with_gains=True, rounds=3, lag_noise=False):
     """(CommandNoiseParams, (g_v, g_w, se_v, se_w)) by maximum likelihood of
     the increments' errors summed over windows of `window` steps (1: every
-    step on its own); the gains 1 when not `with_gains`."""
+    step on its own); the gains 1 when not `with_gains`; with `lag_noise`
+    also the lag term's fraction (lag_noise_fraction, the seventh value)."""
     windows = windows_of(runs_steps, window)
     steps = [s for run_steps in runs_steps for s in run_steps]
     gains = (1.0, 1.0, 0.0, 0.0)
-    p = [0.01, 0.05, 0.01, 0.05, 0.3, 0.1]
+    p = [0.01, 0.05, 0.01, 0.05, 0.3, 0.1] + ([0.1] if lag_noise else [])
     for _ in range(rounds if with_gains else 1):
         p = fit(lambda q: gaussian_nll(window_pairs(windows, q, gains[:2])), p)
         if with_gains:
@@ -526,7 +531,7 @@ def read_runs(dirs, offset):
 
 
 COMMAND_NAMES = ["v_noise_std_mps", "v_noise_fraction", "w_noise_std_radps", "w_noise_fraction",
-                 "change_noise_fraction", "settle_noise_fraction"]
+                 "change_noise_fraction", "settle_noise_fraction", "lag_noise_fraction"]
 ODOMETRY_NAMES = ["distance_noise_std_m", "distance_noise_std_m_per_sqrt_m",
                   "heading_noise_std_rad", "heading_noise_std_rad_per_sqrt_m",
                   "heading_noise_std_rad_per_sqrt_rad"]
@@ -682,6 +687,9 @@ def main():
                         help="fit the point beside the axle the robot turns about on the spot "
                              "(fit_turn_centre) and take its motion out of the true steps "
                              "the slip is fitted to")
+    parser.add_argument("--lag-noise", action="store_true",
+                        help="also fit a command noise growing with the gap between the command "
+                             "and the followed speed (command_noise.lag_noise_fraction)")
     parser.add_argument("--json", help="also write the fitted values to this JSON file")
     parser.add_argument("--consistency", metavar="WORK",
                         help="run the training sweeps in WORK and scale the noise against the "
@@ -742,7 +750,8 @@ def main():
             return 2
         take_out_turn_centre(steps, turn_centre[0])
         c, k = fit_skid(steps)
-    command, gains = fit_command(runs_steps, args.window, not args.no_gain)
+    command, gains = fit_command(runs_steps, args.window, not args.no_gain,
+                                 lag_noise=args.lag_noise)
 
     print(f"# scripts/calibrate_noise.py: {len(steps)} steps from {len(runs)} runs")
     print("slam:\n  ekf:")

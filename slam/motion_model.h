@@ -80,7 +80,8 @@ Twist2 FollowCommand(const Twist2& followed, const Twist2& command, double dt_s,
 /// to its commands); covariance diag((dt sigma_v)^2, (dt sigma_w)^2) with
 ///   sigma_v = v_noise_scale (v_noise_std_mps + v_noise_fraction |v|
 ///             + change_noise_fraction |command.v - previous.v|
-///             + settle_noise_fraction |previous_change.v|)   (likewise w),
+///             + settle_noise_fraction |previous_change.v|
+///             + lag_noise_fraction |command.v - v|)   (likewise w),
 /// `previous` being the command of the record before and `previous_change`
 /// the change of the command at that record (its command less the one
 /// before it; zero at the first records) (CommandNoiseParams).

@@ -43,6 +43,7 @@ std::vector<ParamProblem> CommandNoiseParams::Validate() const {
   check.NonNegative("w_noise_fraction", w_noise_fraction);
   check.NonNegative("change_noise_fraction", change_noise_fraction);
   check.NonNegative("settle_noise_fraction", settle_noise_fraction);
+  check.NonNegative("lag_noise_fraction", lag_noise_fraction);
   check.Positive("v_noise_scale", v_noise_scale);
   check.Positive("w_noise_scale", w_noise_scale);
   // A zero constant part would make a stopped robot's prediction exact.

@@ -92,6 +92,12 @@ struct CommandNoiseParams {
   /// which the first-order lag (EkfParams::command_lag_s) does not follow
   /// (docs/method.md, departure 22). 0: no such term.
   double settle_noise_fraction = 0.0;
+  /// Part of the noise proportional to the gap between the command and the
+  /// speeds the wheels follow it with (|v - v_followed|, likewise w;
+  /// dimensionless; EkfParams::command_lag_s): the wheels catching up after a
+  /// change, a start or a stop move in ways the first-order lag follows only
+  /// roughly (docs/method.md, departure 25). 0 (the default): no such term.
+  double lag_noise_fraction = 0.0;
   /// Factor on the whole of sigma_v (dimensionless, > 0): the fitted shape
   /// above kept, its size set against the filters' consistency on training
   /// runs (scripts/calibrate_noise.py --nees; docs/method.md, "Calibrating the
@@ -108,6 +114,7 @@ struct CommandNoiseParams {
     a->Visit(MJSLAM_NVP(w_noise_fraction));
     a->Visit(MJSLAM_NVP(change_noise_fraction));
     a->Visit(MJSLAM_NVP(settle_noise_fraction));
+    a->Visit(MJSLAM_NVP(lag_noise_fraction));
     a->Visit(MJSLAM_NVP(v_noise_scale));
     a->Visit(MJSLAM_NVP(w_noise_scale));
   }

@@ -35,6 +35,7 @@ void ExpectPaperChoices(const app::RunConfig& config) {
   EXPECT_EQ(ekf.extra_corner_range_std_m, 0.0);
   EXPECT_EQ(ekf.extra_corner_bearing_std_rad, 0.0);
   EXPECT_EQ(ekf.command_noise.change_noise_fraction, 0.0);
+  EXPECT_EQ(ekf.command_noise.lag_noise_fraction, 0.0);
   EXPECT_EQ(ekf.command_gain_v, 1.0);
   EXPECT_EQ(ekf.command_gain_w, 1.0);
   EXPECT_EQ(ekf.command_lag_s, 0.0);

@@ -512,6 +512,24 @@ TEST(MotionModelTest, SettleNoiseFollowsThePreviousChange) {
   EXPECT_EQ(noise.Validate()[0].key, "settle_noise_fraction");
 }
 
+TEST(MotionModelTest, LagNoiseFollowsTheGapToTheCommand) {
+  CommandNoiseParams noise = TestCommandNoise();
+  noise.lag_noise_fraction = 0.5;
+  // The wheels at (0.3, -0.1) catching up with the command (0.5, -0.4) held
+  // since the record before: sigma grows by 0.5 of the gap, 0.1 and 0.15.
+  const Twist2 command{0.5, -0.4};
+  const Twist2 followed{0.3, -0.1};
+  const MotionInput catching_up = CommandInput(command, 0.2, noise, command, 1.0, 1.0, &followed);
+  EXPECT_NEAR(std::sqrt(catching_up.covariance(0, 0)), 0.2 * (0.02 + 0.03 + 0.1), 1e-12);
+  EXPECT_NEAR(std::sqrt(catching_up.covariance(1, 1)), 0.2 * (0.01 + 0.02 + 0.15), 1e-12);
+  // Caught up (or no lag): no such term.
+  const MotionInput caught_up = CommandInput(command, 0.2, noise, command, 1.0, 1.0, &command);
+  EXPECT_NEAR(std::sqrt(caught_up.covariance(0, 0)), 0.2 * (0.02 + 0.05), 1e-12);
+  noise.lag_noise_fraction = -0.1;
+  ASSERT_EQ(noise.Validate().size(), 1u);
+  EXPECT_EQ(noise.Validate()[0].key, "lag_noise_fraction");
+}
+
 TEST(MotionModelTest, OdometryInputIsTheIncrementInThePreviousFrame) {
   OdometryNoiseParams noise;
   // From (1, 1, pi/2), an arc of 0.3 m turning by 0.2 (a = 0.2): the input
