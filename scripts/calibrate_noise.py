@@ -1,11 +1,11 @@
 #!/usr/bin/python3
 """Calibrates the filters' process model from the true motion of runs: the
 values of slam.ekf.command_gain_v, _w, slam.ekf.command_noise.*, slam.ekf.odometry_noise.*,
-slam.ekf.lateral_skid_s and slam.ekf.lateral_slip_std_m_per_rad
-(docs/method.md, "Calibrating the process noise").
+slam.ekf.lateral_skid_s, slam.ekf.lateral_slip_std_m_per_rad (and by regime) and
+slam.ekf.turn_centre_offset_m_per_radps (docs/method.md, "Calibrating the process noise").
 
     scripts/calibrate_noise.py DIR [DIR ...] [--offset A] [--window L] [--no-gain] [--no-lag]
-                               [--slip-by-regime] [--json FILE]
+                               [--slip-by-regime] [--turn-centre] [--json FILE]
     scripts/calibrate_noise.py --consistency WORK --write CONFIG [--config BASE] [--seed S]
                                [--runs N] [--jobs J] [--iterations K] [--tolerance T]
 
@@ -25,7 +25,8 @@ an arc along the mid-arc heading, plus a sideways skid):
   by the gains g_v and g_w (slam.ekf.command_gain_v, _w: the
   robot's mean speed over its command), its noise growing with the change
   from the command of row k-2 and with the change one row earlier (row k-2
-  from row k-3: the wheels still settling). The errors e_v = d / dt - g_v v_f and
+  from row k-3: the wheels still settling), and with --lag-noise with the gap
+  between the command and the followed speed (lag_noise_fraction). The errors e_v = d / dt - g_v v_f and
   e_w = dth / dt - g_w w_f (v_f, w_f the speeds followed) of the true increment (d, dth) are modelled as
   independent zero-mean Gaussians with
       sigma_v = v_noise_std_mps + v_noise_fraction |v_f| + change_noise_fraction |v - v_prev|
@@ -53,6 +54,17 @@ an arc along the mid-arc heading, plus a sideways skid):
   the speed and the slip at a change of the turn rate
   (lateral_slip_std_m_per_rad, _per_rad_per_mps, _per_radps_change;
   docs/method.md, departure 23), by maximum likelihood (fit_slip_by_regime).
+- turn centre (--turn-centre): on the spot (the command and the one before
+  with v = 0) the robot turns about a point s w beside its axle
+  (turn_centre_offset_m_per_radps, departure 24; slam::TurnCentre): the axle
+  moves by s (w n(th') - w_prev n(th)), -s (w + w_prev) sin(dth/2) along the
+  mid-arc heading and s (w - w_prev) cos(dth/2) across it (w, w_prev the
+  turn-rate commands of rows k-1 and k-2, dth the true turn). s is fitted
+  first (after the lag), by least squares of both components together
+  (fit_turn_centre; the fits of each alone are printed too), and this mean
+  motion is taken out of the true steps before everything else is fitted to
+  them: the gains, the command noise and the sideways slip are those of the
+  residuals.
 
 Prints the fitted values as the YAML of configs/default.yaml's slam.ekf
 section, and for each fit the mean of (error / sigma)^2 (1 for a model that
@@ -147,6 +159,7 @@ def read_steps(run, offset):
         d, dth, lateral = axle_increment(*true0, *true1, offset)
         d_odom, dth_odom, _ = axle_increment(*odom0, *odom1, offset)
         steps.append({"dt": dt, "v": v, "w": w, "dv": abs(v - v_prev), "dw": abs(w - w_prev),
+                      "on_the_spot": v == 0.0 and v_prev == 0.0, "w_prev": w_prev,
                       "d": d, "dth": dth, "lateral": lateral,
                       "d_odom": d_odom, "dth_odom": dth_odom})
     # The change of the command one row earlier (zero at the first step).
@@ -217,11 +230,14 @@ def gaussian_nll(errors_and_variances):
 
 def command_sigmas(s, p):
     """(sigma_v, sigma_w) of CommandInput for step s, p = (v0, kv, w0, kw, kc,
-    ks): ks the settle term's fraction (0 when p has five values)."""
+    ks[, kl]): ks the settle term's fraction (0 when p has five values), kl
+    the lag term's (of the gap between the command and the followed speed;
+    0 when p has six values)."""
     v0, kv, w0, kw, kc = p[:5]
     ks = p[5] if len(p) > 5 else 0.0
-    return (v0 + kv * abs(s["fv"]) + kc * s["dv"] + ks * s["dv1"],
-            w0 + kw * abs(s["fw"]) + kc * s["dw"] + ks * s["dw1"])
+    kl = p[6] if len(p) > 6 else 0.0
+    return (v0 + kv * abs(s["fv"]) + kc * s["dv"] + ks * s["dv1"] + kl * abs(s["v"] - s["fv"]),
+            w0 + kw * abs(s["fw"]) + kc * s["dw"] + ks * s["dw1"] + kl * abs(s["w"] - s["fw"]))
 
 
 def command_errors(s, gains=(1.0, 1.0)):
@@ -335,14 +351,15 @@ def window_pairs(windows, p, gains=(1.0, 1.0)):
     return pairs
 
 
-def fit_command(runs_steps, window, with_gains=True, rounds=3):
+def fit_command(runs_steps, window, with_gains=True, rounds=3, lag_noise=False):
     """(CommandNoiseParams, (g_v, g_w, se_v, se_w)) by maximum likelihood of
     the increments' errors summed over windows of `window` steps (1: every
-    step on its own); the gains 1 when not `with_gains`."""
+    step on its own); the gains 1 when not `with_gains`; with `lag_noise`
+    also the lag term's fraction (lag_noise_fraction, the seventh value)."""
     windows = windows_of(runs_steps, window)
     steps = [s for run_steps in runs_steps for s in run_steps]
     gains = (1.0, 1.0, 0.0, 0.0)
-    p = [0.01, 0.05, 0.01, 0.05, 0.3, 0.1]
+    p = [0.01, 0.05, 0.01, 0.05, 0.3, 0.1] + ([0.1] if lag_noise else [])
     for _ in range(rounds if with_gains else 1):
         p = fit(lambda q: gaussian_nll(window_pairs(windows, q, gains[:2])), p)
         if with_gains:
@@ -400,6 +417,69 @@ def fit_skid(steps):
     return c, math.sqrt(residual2 / turned2)
 
 
+def sideways_residual(s, c):
+    """What the skid c leaves of the axle's sideways motion."""
+    return s["lateral"] - c * (-s["d"] * s["dth"] / s["dt"])
+
+
+def turn_centre_regressors(s):
+    """(along, across): the axle's motion over step s, along and across the
+    mid-arc heading, per metre per rad/s of the turn centre's offset (zero
+    off the spot): -(w + w_prev) sin(dth/2) and (w - w_prev) cos(dth/2)."""
+    if not s["on_the_spot"]:
+        return 0.0, 0.0
+    half = 0.5 * s["dth"]
+    return -(s["w"] + s["w_prev"]) * math.sin(half), (s["w"] - s["w_prev"]) * math.cos(half)
+
+
+def fit_turn_centre(steps, c):
+    """(s, s_along, s_across): the turn centre's offset per rad/s
+    (--turn-centre; slam.ekf.turn_centre_offset_m_per_radps) from the axle's
+    motion on the spot along and across the mid-arc heading
+    (turn_centre_regressors): s_along and s_across by least squares of each
+    component alone, s by weighted least squares of both together, each
+    component weighted by the inverse of its mean squared residual from its
+    own fit (the along component carries the wheels' forward noise, tens of
+    micrometres a step, the across one a few). Along: the chord less the chord
+    of the followed speed (apply_lag first); across: what the skid c leaves
+    (sideways_residual)."""
+    rows = {"along": [], "across": []}
+    for s in steps:
+        if not s["on_the_spot"]:
+            continue
+        x_along, x_across = turn_centre_regressors(s)
+        half = 0.5 * s["dth"]
+        sinc = 1.0 - half * half / 6.0 if abs(half) < 1e-4 else math.sin(half) / half
+        rows["along"].append((x_along, (s["d"] - s["fv"] * s["dt"]) * sinc))
+        rows["across"].append((x_across, sideways_residual(s, c)))
+    alone = {}
+    weighted_xx = weighted_xy = 0.0
+    for key, pairs in rows.items():
+        sxx = sum(x * x for x, _ in pairs)
+        if sxx == 0.0:
+            raise ValueError("no turn and no change of the turn rate on the spot: the turn "
+                             "centre is undetermined")
+        alone[key] = sum(x * y for x, y in pairs) / sxx
+        mean_square = sum((y - alone[key] * x) ** 2 for x, y in pairs) / len(pairs)
+        weight = 1.0 / max(mean_square, 1e-300)
+        weighted_xx += weight * sxx
+        weighted_xy += weight * alone[key] * sxx
+    return weighted_xy / weighted_xx, alone["along"], alone["across"]
+
+
+def take_out_turn_centre(steps, offset):
+    """Takes the turn about the point `offset` w beside the axle out of the
+    true steps (d, lateral), so that what follows is fitted to the rest."""
+    for s in steps:
+        x_along, x_across = turn_centre_regressors(s)
+        if x_along == 0.0 and x_across == 0.0:
+            continue
+        half = 0.5 * s["dth"]
+        sinc = 1.0 - half * half / 6.0 if abs(half) < 1e-4 else math.sin(half) / half
+        s["d"] -= offset * x_along / sinc
+        s["lateral"] -= offset * x_across
+
+
 def fit_slip_by_regime(steps, c, gain_v):
     """(k0, k1, kc): the sideways slip by regime (--slip-by-regime), fitted
     by maximum likelihood to what the skid c leaves, r, modelled as a
@@ -412,7 +492,7 @@ def fit_slip_by_regime(steps, c, gain_v):
     information and are left out."""
     rows = []
     for s in steps:
-        r = s["lateral"] - c * (-s["d"] * s["dth"] / s["dt"])
+        r = sideways_residual(s, c)
         turn2 = s["dth"] ** 2
         if turn2 == 0.0 and s["dw"] == 0.0:
             continue
@@ -451,7 +531,7 @@ def read_runs(dirs, offset):
 
 
 COMMAND_NAMES = ["v_noise_std_mps", "v_noise_fraction", "w_noise_std_radps", "w_noise_fraction",
-                 "change_noise_fraction", "settle_noise_fraction"]
+                 "change_noise_fraction", "settle_noise_fraction", "lag_noise_fraction"]
 ODOMETRY_NAMES = ["distance_noise_std_m", "distance_noise_std_m_per_sqrt_m",
                   "heading_noise_std_rad", "heading_noise_std_rad_per_sqrt_m",
                   "heading_noise_std_rad_per_sqrt_rad"]
@@ -603,6 +683,13 @@ def main():
                         help="fit the sideways slip per radian turned on the spot, its growth "
                              "with the speed and its jolt at a change of the turn rate "
                              "(fit_slip_by_regime) instead of one value per radian")
+    parser.add_argument("--turn-centre", action="store_true",
+                        help="fit the point beside the axle the robot turns about on the spot "
+                             "(fit_turn_centre) and take its motion out of the true steps "
+                             "the slip is fitted to")
+    parser.add_argument("--lag-noise", action="store_true",
+                        help="also fit a command noise growing with the gap between the command "
+                             "and the followed speed (command_noise.lag_noise_fraction)")
     parser.add_argument("--json", help="also write the fitted values to this JSON file")
     parser.add_argument("--consistency", metavar="WORK",
                         help="run the training sweeps in WORK and scale the noise against the "
@@ -651,8 +738,20 @@ def main():
         return 2
     lag = 0.0 if args.no_lag else fit_lag(runs_steps)
     apply_lag(runs_steps, lag)
-    command, gains = fit_command(runs_steps, args.window, not args.no_gain)
+    # The odometry against the true steps as they are (the turn centre is a
+    # model of the command input only).
     odometry = fit_odometry(steps)
+    turn_centre = None
+    if args.turn_centre:
+        try:
+            turn_centre = fit_turn_centre(steps, c)
+        except ValueError as e:
+            print(f"calibrate_noise: {e}", file=sys.stderr)
+            return 2
+        take_out_turn_centre(steps, turn_centre[0])
+        c, k = fit_skid(steps)
+    command, gains = fit_command(runs_steps, args.window, not args.no_gain,
+                                 lag_noise=args.lag_noise)
 
     print(f"# scripts/calibrate_noise.py: {len(steps)} steps from {len(runs)} runs")
     print("slam:\n  ekf:")
@@ -667,6 +766,9 @@ def main():
         print(f"      {name}: {value:.4g}")
     print(f"    lateral_skid_s: {c:.4g}")
     slip = fit_slip_by_regime(steps, c, gains[0]) if args.slip_by_regime else None
+    if turn_centre:
+        print(f"    turn_centre_offset_m_per_radps: {turn_centre[0]:.4g}   # along alone "
+              f"{turn_centre[1]:.4g}, across alone {turn_centre[2]:.4g}")
     if slip:
         k0, k1, kc = slip
         print(f"    lateral_slip_std_m_per_rad: {k0:.4g}")
@@ -705,6 +807,11 @@ def main():
     print_bins("command v", steps, "dv", [0, 1e-9, 0.05, 0.15, 0.3, 10], nv)
     print_bins("command w", steps, "|w|", [0, 0.05, 0.3, 0.8, 1.5, 10], nw)
     print_bins("command w", steps, "dw", [0, 1e-9, 0.1, 0.3, 0.8, 10], nw)
+    spinning = [s for s in steps if s["on_the_spot"] and s["w"] != 0.0]
+    if spinning:
+        print(f"  on the spot, turning: {len(spinning)} steps, mean (e/sigma)^2 = "
+              f"{sum(nv(s) for s in spinning) / len(spinning):.2f} (v), "
+              f"{sum(nw(s) for s in spinning) / len(spinning):.2f} (w)")
 
     def nd(s):
         return (s["d_odom"] - s["d"]) ** 2 / odometry_variances(s, odometry)[0]
@@ -720,6 +827,10 @@ def main():
     if args.json:
         values = {"steps": len(steps), "runs": len(runs),
                   **ekf_values(gains, lag, command, odometry, c, k)}
+        if turn_centre:
+            values["turn_centre_offset_m_per_radps"] = turn_centre[0]
+            values["turn_centre_offset_along_alone"] = turn_centre[1]
+            values["turn_centre_offset_across_alone"] = turn_centre[2]
         if slip:
             values.update(zip(["lateral_slip_std_m_per_rad", "lateral_slip_std_m_per_rad_per_mps",
                                "lateral_slip_std_m_per_radps_change"], slip))

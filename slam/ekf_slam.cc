@@ -232,6 +232,14 @@ MotionInput EkfSlam::CheckedMotionInput(const SensorRecord& record) const {
     const double change_std = params_.lateral_slip_std_m_per_radps_change *
                               std::abs(record.command.w_radps - previous_command_.w_radps);
     input.lateral_variance_m2 += change_std * change_std;
+    // On the spot the robot turns about a point beside its axle, at a
+    // distance proportional to the commanded turn rate (departure 24).
+    if (record.command.v_mps == 0.0 && previous_command_.v_mps == 0.0) {
+      input.turn_centre.offset_m =
+          params_.turn_centre_offset_m_per_radps * record.command.w_radps;
+      input.turn_centre.previous_offset_m =
+          params_.turn_centre_offset_m_per_radps * previous_command_.w_radps;
+    }
   }
   if (record.dt_s > 0.0) input.skid_per_m_rad = params_.lateral_skid_s / record.dt_s;
   input.integration = integration_;

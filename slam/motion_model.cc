@@ -49,7 +49,8 @@ Eigen::Vector3d ApplyStep(const Eigen::Vector3d& pose_WR, double dth, const Plan
 // Eq. (6) integrated exactly: the axle centre on the arc, R moving by the
 // chord d sinc(dth/2) along the mid-arc heading and by 2 a sin(dth/2) across
 // it (h swinging about the axle), less the skid.
-PlanarStep ExactStep(double th, double d, double dth, double a_m, double skid_per_m_rad) {
+PlanarStep ExactStep(double th, double d, double dth, double a_m, double skid_per_m_rad,
+                     const TurnCentre& centre) {
   const double half = 0.5 * dth;
   // sinc(half) and its derivative with respect to dth.
   double sinc, dsinc;
@@ -66,16 +67,34 @@ PlanarStep ExactStep(double th, double d, double dth, double a_m, double skid_pe
   step.forward = d * sinc;
   step.dforward_dd = sinc;
   step.dforward_ddth = d * dsinc;
-  // Sideways: the point h swinging about the axle, and the skid outward.
+  // Sideways: the point h swinging about the axle and the skid outward.
   step.lateral = 2.0 * a_m * std::sin(half) - skid_per_m_rad * d * dth;
   step.dlateral_dd = -skid_per_m_rad * dth;
   step.dlateral_ddth = a_m * std::cos(half) - skid_per_m_rad * d;
+  // The turn about a point beside the axle: the axle, c_prev to the left of
+  // that point at the start heading th and c at th + dth, moves by
+  // c n(th + dth) - c_prev n(th) (n the left normal), which is
+  // -(c + c_prev) sin(dth/2) along the mid-arc heading and
+  // (c - c_prev) cos(dth/2) across it.
+  const double sum = centre.offset_m + centre.previous_offset_m;
+  const double change = centre.offset_m - centre.previous_offset_m;
+  if (sum != 0.0 || change != 0.0) {
+    const double s = std::sin(half);
+    const double c = std::cos(half);
+    step.forward -= sum * s;
+    step.dforward_ddth -= 0.5 * sum * c;
+    step.lateral += change * c;
+    step.dlateral_ddth -= 0.5 * change * s;
+  }
   return step;
 }
 
 // The paper's forward-Euler Eq. (6): d along the start heading th, a dth
-// across it for the point h ahead of the axle, less the skid.
-PlanarStep EulerStep(double th, double d, double dth, double a_m, double skid_per_m_rad) {
+// across it for the point h ahead of the axle, less the skid, plus the turn
+// about a point beside the axle to first order: c n(th + dth) - c_prev n(th)
+// with n(th + dth) ~ n(th) - dth f(th) (f the heading's unit vector).
+PlanarStep EulerStep(double th, double d, double dth, double a_m, double skid_per_m_rad,
+                     const TurnCentre& centre) {
   PlanarStep step;
   step.phi = th;
   step.forward = d;
@@ -83,6 +102,11 @@ PlanarStep EulerStep(double th, double d, double dth, double a_m, double skid_pe
   step.lateral = a_m * dth - skid_per_m_rad * d * dth;
   step.dlateral_dd = -skid_per_m_rad * dth;
   step.dlateral_ddth = a_m - skid_per_m_rad * d;
+  if (centre.offset_m != 0.0 || centre.previous_offset_m != 0.0) {
+    step.forward -= centre.offset_m * dth;
+    step.dforward_ddth = -centre.offset_m;
+    step.lateral += centre.offset_m - centre.previous_offset_m;
+  }
   return step;
 }
 
@@ -90,12 +114,14 @@ PlanarStep EulerStep(double th, double d, double dth, double a_m, double skid_pe
 
 Eigen::Vector3d PredictPose(const Eigen::Vector3d& pose_WR, const Eigen::Vector2d& increment,
                             double a_m, Eigen::Matrix3d* A, Eigen::Matrix<double, 3, 2>* W,
-                            double skid_per_m_rad, MotionIntegration integration) {
+                            double skid_per_m_rad, MotionIntegration integration,
+                            const TurnCentre& turn_centre) {
   const double d = increment.x();
   const double dth = increment.y();
-  const PlanarStep step = integration == MotionIntegration::kEuler
-                              ? EulerStep(pose_WR.z(), d, dth, a_m, skid_per_m_rad)
-                              : ExactStep(pose_WR.z(), d, dth, a_m, skid_per_m_rad);
+  const PlanarStep step =
+      integration == MotionIntegration::kEuler
+          ? EulerStep(pose_WR.z(), d, dth, a_m, skid_per_m_rad, turn_centre)
+          : ExactStep(pose_WR.z(), d, dth, a_m, skid_per_m_rad, turn_centre);
   return ApplyStep(pose_WR, dth, step, A, W);
 }
 
@@ -117,12 +143,14 @@ MotionInput CommandInput(const Twist2& command, double dt_s, const CommandNoiseP
       noise.v_noise_scale *
       (noise.v_noise_std_mps + noise.v_noise_fraction * std::abs(speeds.v_mps) +
        noise.change_noise_fraction * std::abs(command.v_mps - previous.v_mps) +
-       noise.settle_noise_fraction * std::abs(previous_change.v_mps));
+       noise.settle_noise_fraction * std::abs(previous_change.v_mps) +
+       noise.lag_noise_fraction * std::abs(command.v_mps - speeds.v_mps));
   const double sigma_w =
       noise.w_noise_scale *
       (noise.w_noise_std_radps + noise.w_noise_fraction * std::abs(speeds.w_radps) +
        noise.change_noise_fraction * std::abs(command.w_radps - previous.w_radps) +
-       noise.settle_noise_fraction * std::abs(previous_change.w_radps));
+       noise.settle_noise_fraction * std::abs(previous_change.w_radps) +
+       noise.lag_noise_fraction * std::abs(command.w_radps - speeds.w_radps));
   input.covariance = Eigen::Vector2d(dt_s * dt_s * sigma_v * sigma_v,
                                      dt_s * dt_s * sigma_w * sigma_w)
                          .asDiagonal();

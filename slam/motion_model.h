@@ -8,6 +8,20 @@
 
 namespace mjslam::slam {
 
+/// Where the robot turns about, when not about its axle centre: the axle
+/// lies `offset_m` to the left of that point (across the heading) at the end
+/// of the step and `previous_offset_m` at its start; the point stays where it
+/// is in W over the step. So the axle moves by
+///   offset_m n(th + dth) - previous_offset_m n(th),
+/// n(th) = (-sin th, cos th) the left normal: sideways by the change of the
+/// offset (a shift when the turn rate changes) and, with the offset held,
+/// around the point (-2 offset_m sin(dth / 2) along the mid-arc heading:
+/// backward when the point lies on the outside of the turn).
+struct TurnCentre {
+  double offset_m = 0.0;
+  double previous_offset_m = 0.0;
+};
+
 /// The input of the paper's Eq. (6) integrated over one record: the products
 /// `u dt` (distance, metres) and `w dt` (heading change, radians). The filter
 /// works with these increments so that dt = 0 and odometry need no division.
@@ -24,6 +38,9 @@ struct MotionInput {
   /// R moves by -skid d dth across the mid-arc heading (EkfParams::lateral_skid_s
   /// divided by dt). 0: Eq. (6) alone.
   double skid_per_m_rad = 0.0;
+  /// The point the robot turns about on the spot, beside its axle
+  /// (EkfParams::turn_centre_offset_m_per_radps). Zero: the axle itself.
+  TurnCentre turn_centre;
   /// How Eq. (6) is integrated over the step (EkfParams::motion_integration).
   MotionIntegration integration = MotionIntegration::kExact;
 };
@@ -35,15 +52,18 @@ struct MotionInput {
 ///   th' = wrap(th + dth),
 /// integrated exactly (kExact: the axle centre on an arc, docs/method.md
 /// departure 9), plus a skid of -skid_per_m_rad d dth across the mid-arc
-/// heading (MotionInput::skid_per_m_rad); or, with kEuler, the forward-Euler
-/// step above as the paper writes it, the skid then across the start heading
-/// th. If not null, `A` receives d pose' / d pose and `W` d pose' / d
+/// heading (MotionInput::skid_per_m_rad) and the turn about `turn_centre`
+/// (TurnCentre: exactly, the point fixed over the step); or, with kEuler,
+/// the forward-Euler step above as the paper writes it, the skid then across
+/// the start heading th and the turn about `turn_centre` to first order in
+/// dth. If not null, `A` receives d pose' / d pose and `W` d pose' / d
 /// increment, of the integration chosen.
 Eigen::Vector3d PredictPose(const Eigen::Vector3d& pose_WR, const Eigen::Vector2d& increment,
                             double a_m, Eigen::Matrix3d* A = nullptr,
                             Eigen::Matrix<double, 3, 2>* W = nullptr,
                             double skid_per_m_rad = 0.0,
-                            MotionIntegration integration = MotionIntegration::kExact);
+                            MotionIntegration integration = MotionIntegration::kExact,
+                            const TurnCentre& turn_centre = TurnCentre());
 
 /// The speeds the robot moves at over a step of `dt_s` (>= 0) when it
 /// follows `command` through a first-order lag of time constant `lag_s`
@@ -60,7 +80,8 @@ Twist2 FollowCommand(const Twist2& followed, const Twist2& command, double dt_s,
 /// to its commands); covariance diag((dt sigma_v)^2, (dt sigma_w)^2) with
 ///   sigma_v = v_noise_scale (v_noise_std_mps + v_noise_fraction |v|
 ///             + change_noise_fraction |command.v - previous.v|
-///             + settle_noise_fraction |previous_change.v|)   (likewise w),
+///             + settle_noise_fraction |previous_change.v|
+///             + lag_noise_fraction |command.v - v|)   (likewise w),
 /// `previous` being the command of the record before and `previous_change`
 /// the change of the command at that record (its command less the one
 /// before it; zero at the first records) (CommandNoiseParams).

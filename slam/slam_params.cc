@@ -43,6 +43,7 @@ std::vector<ParamProblem> CommandNoiseParams::Validate() const {
   check.NonNegative("w_noise_fraction", w_noise_fraction);
   check.NonNegative("change_noise_fraction", change_noise_fraction);
   check.NonNegative("settle_noise_fraction", settle_noise_fraction);
+  check.NonNegative("lag_noise_fraction", lag_noise_fraction);
   check.Positive("v_noise_scale", v_noise_scale);
   check.Positive("w_noise_scale", w_noise_scale);
   // A zero constant part would make a stopped robot's prediction exact.
@@ -81,6 +82,8 @@ std::vector<ParamProblem> EkfParams::Validate() const {
   check.NonNegative("lateral_slip_std_m_per_rad", lateral_slip_std_m_per_rad);
   check.NonNegative("lateral_slip_std_m_per_rad_per_mps", lateral_slip_std_m_per_rad_per_mps);
   check.NonNegative("lateral_slip_std_m_per_radps_change", lateral_slip_std_m_per_radps_change);
+  check.Require(std::isfinite(turn_centre_offset_m_per_radps), "turn_centre_offset_m_per_radps",
+                turn_centre_offset_m_per_radps, "a finite value");
   check.NonNegative("lateral_skid_s", lateral_skid_s);
   check.OneOf("jacobians", jacobians,
               std::vector<std::string>(std::begin(kJacobianPointNames),

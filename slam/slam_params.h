@@ -92,6 +92,12 @@ struct CommandNoiseParams {
   /// which the first-order lag (EkfParams::command_lag_s) does not follow
   /// (docs/method.md, departure 22). 0: no such term.
   double settle_noise_fraction = 0.0;
+  /// Part of the noise proportional to the gap between the command and the
+  /// speeds the wheels follow it with (|v - v_followed|, likewise w;
+  /// dimensionless; EkfParams::command_lag_s): the wheels catching up after a
+  /// change, a start or a stop move in ways the first-order lag follows only
+  /// roughly (docs/method.md, departure 25). 0 (the default): no such term.
+  double lag_noise_fraction = 0.0;
   /// Factor on the whole of sigma_v (dimensionless, > 0): the fitted shape
   /// above kept, its size set against the filters' consistency on training
   /// runs (scripts/calibrate_noise.py --nees; docs/method.md, "Calibrating the
@@ -108,6 +114,7 @@ struct CommandNoiseParams {
     a->Visit(MJSLAM_NVP(w_noise_fraction));
     a->Visit(MJSLAM_NVP(change_noise_fraction));
     a->Visit(MJSLAM_NVP(settle_noise_fraction));
+    a->Visit(MJSLAM_NVP(lag_noise_fraction));
     a->Visit(MJSLAM_NVP(v_noise_scale));
     a->Visit(MJSLAM_NVP(w_noise_scale));
   }
@@ -205,6 +212,19 @@ struct EkfParams {
   /// that starts or stops turning jolts sideways). 0 (the default): none
   /// (docs/method.md, departure 23).
   double lateral_slip_std_m_per_radps_change = 0.0;
+  /// The point a robot turning on the spot turns about, beside its axle,
+  /// metres per rad/s of the commanded turn rate (signed), with the command
+  /// input only: when the command and the one of the record before both
+  /// have v = 0, the axle lies this times w to the left of the point it
+  /// turns about (for a positive value and w > 0: the point on the right, the
+  /// outside of the turn), the point fixed in W over the step
+  /// (slam::TurnCentre). Its two consequences: a sideways shift of the axle
+  /// by this (w - w_previous) when the turn rate changes and, while it is
+  /// held, the axle circling the point (for a positive value a backward
+  /// creep of about this w^2 dt per step). The same in every run, so a mean
+  /// motion, not a spread. 0 (the default): the turn about the axle
+  /// (docs/method.md, departure 24).
+  double turn_centre_offset_m_per_radps = 0.0;
   /// Sideways skid of the axle centre in turns, seconds: Eq. (6) has no
   /// sideways motion, but tyres skid to the outside of a turn at a speed
   /// proportional to the centripetal acceleration, c v w. The prediction
@@ -309,6 +329,7 @@ struct EkfParams {
     a->Visit(MJSLAM_NVP(lateral_slip_std_m_per_rad));
     a->Visit(MJSLAM_NVP(lateral_slip_std_m_per_rad_per_mps));
     a->Visit(MJSLAM_NVP(lateral_slip_std_m_per_radps_change));
+    a->Visit(MJSLAM_NVP(turn_centre_offset_m_per_radps));
     a->Visit(MJSLAM_NVP(lateral_skid_s));
     a->Visit(MJSLAM_NVP(jacobians));
     a->Visit(MJSLAM_NVP(initial_position_std_m));

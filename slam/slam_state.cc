@@ -49,7 +49,7 @@ void SlamState::Predict(const MotionInput& input, double a_m) {
   Eigen::Matrix3d A;
   Eigen::Matrix<double, 3, 2> W;
   x_.head<3>() = PredictPose(x_.head<3>(), input.increment, a_m, &A, &W, input.skid_per_m_rad,
-                             input.integration);
+                             input.integration, input.turn_centre);
   if (jacobians_ == JacobianPoint::kFirstEstimates) {
     // FEJ (Huang et al. 2010): A = d pose' / d pose is the identity but for
     // the heading column, the displacement rotated by 90 deg; take the

@@ -25,6 +25,7 @@ void ExpectPaperChoices(const app::RunConfig& config) {
   EXPECT_EQ(ekf.lateral_slip_std_m_per_rad, 0.0);
   EXPECT_EQ(ekf.lateral_slip_std_m_per_rad_per_mps, 0.0);
   EXPECT_EQ(ekf.lateral_slip_std_m_per_radps_change, 0.0);
+  EXPECT_EQ(ekf.turn_centre_offset_m_per_radps, 0.0);
   EXPECT_EQ(ekf.lateral_skid_s, 0.0);
   EXPECT_TRUE(ekf.correct_corners_of_matched_lines);
   EXPECT_FALSE(ekf.corners_from_map_lines);
@@ -34,6 +35,7 @@ void ExpectPaperChoices(const app::RunConfig& config) {
   EXPECT_EQ(ekf.extra_corner_range_std_m, 0.0);
   EXPECT_EQ(ekf.extra_corner_bearing_std_rad, 0.0);
   EXPECT_EQ(ekf.command_noise.change_noise_fraction, 0.0);
+  EXPECT_EQ(ekf.command_noise.lag_noise_fraction, 0.0);
   EXPECT_EQ(ekf.command_gain_v, 1.0);
   EXPECT_EQ(ekf.command_gain_w, 1.0);
   EXPECT_EQ(ekf.command_lag_s, 0.0);

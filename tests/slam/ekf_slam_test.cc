@@ -64,6 +64,7 @@ TEST(EkfParamsTest, DefaultsAreValidAndBadValuesAreNamed) {
   params.command_noise.v_noise_fraction = -1.0;
   params.lateral_slip_std_m_per_rad_per_mps = -0.1;
   params.lateral_slip_std_m_per_radps_change = -0.1;
+  params.turn_centre_offset_m_per_radps = std::numeric_limits<double>::infinity();
   const std::vector<ParamProblem> problems = params.Validate();
   std::string keys;
   for (const ParamProblem& problem : problems) keys += problem.key + " ";
@@ -75,7 +76,12 @@ TEST(EkfParamsTest, DefaultsAreValidAndBadValuesAreNamed) {
   EXPECT_NE(keys.find("command_noise.v_noise_fraction"), std::string::npos) << keys;
   EXPECT_NE(keys.find("lateral_slip_std_m_per_rad_per_mps"), std::string::npos) << keys;
   EXPECT_NE(keys.find("lateral_slip_std_m_per_radps_change"), std::string::npos) << keys;
+  EXPECT_NE(keys.find("turn_centre_offset_m_per_radps"), std::string::npos) << keys;
   EXPECT_THROW(params.ValidateOrThrow(), ParamError);
+  // The offset is signed: a negative value is valid.
+  EkfParams left;
+  left.turn_centre_offset_m_per_radps = -1e-4;
+  EXPECT_TRUE(left.Validate().empty());
 }
 
 TEST(EkfParamsTest, MotionIntegrationAndSelectionPolicyAreNamedChoices) {
@@ -288,6 +294,62 @@ TEST(EkfSlamTest, SlipAtAChangeOfTheTurnRate) {
   params.input = "odometry";
   params.odometry_noise = OdometryNoiseParams{0.0, 0.0, 0.0, 0.0, 0.0};
   EXPECT_NEAR(PositionVarianceAfter(params, {{0.0, 0.5}, {0.0, 0.0}}), 0.0, 1e-18);
+}
+
+Pose2 PoseAfter(const EkfParams& params, const std::vector<Twist2>& commands) {
+  EkfSlam filter(params, CorrectionMode::kClassical, Pose2(1.0, 2.0, 0.3), Pose2());
+  SensorRecord record;
+  record.dt_s = 0.1;
+  for (const Twist2& command : commands) {
+    record.command = command;
+    filter.Step(record, nullptr);
+  }
+  return filter.X_WR();
+}
+
+TEST(EkfSlamTest, TurnOnTheSpotAboutAPointBesideTheAxle) {
+  EkfParams params = SlipOnlyParams();
+  params.lateral_slip_std_m_per_rad = 0.0;
+  EkfParams offset = params;
+  offset.turn_centre_offset_m_per_radps = 0.001;
+  const auto left = [](double th) { return Eigen::Vector2d(-std::sin(th), std::cos(th)); };
+  // On the spot from rest at 0.5 rad/s, held, stopped (0.05 rad a step from
+  // heading 0.3; the axle 0.5 mm left of the point it turns about while
+  // w = 0.5): each step moves the axle by c n(th') - c_prev n(th), here
+  // 0.5 mm left of heading 0.35, then around the point from 0.35 to 0.4,
+  // then back by 0.5 mm from the left of heading 0.4.
+  const std::vector<Twist2> spot = {{0.0, 0.5}, {0.0, 0.5}, {0.0, 0.0}};
+  const Pose2 plain = PoseAfter(params, spot);
+  const Pose2 moved = PoseAfter(offset, spot);
+  const Eigen::Vector2d expected =
+      0.0005 * left(0.35) + 0.0005 * (left(0.4) - left(0.35)) - 0.0005 * left(0.4);
+  EXPECT_NEAR(moved.x - plain.x, expected.x(), 1e-15);
+  EXPECT_NEAR(moved.y - plain.y, expected.y(), 1e-15);
+  EXPECT_EQ(moved.theta, plain.theta);
+  // Held for 20 steps of 0.05 rad: the axle circles the point, ending
+  // 0.5 mm left of heading 1.3 rather than of 0.35 (a backward creep).
+  std::vector<Twist2> held(21, Twist2{0.0, 0.5});
+  const Pose2 circled = PoseAfter(offset, held);
+  const Pose2 circled_plain = PoseAfter(params, held);
+  const Eigen::Vector2d expected_circled = 0.0005 * left(0.3 + 21 * 0.05);
+  EXPECT_NEAR(circled.x - circled_plain.x, expected_circled.x(), 1e-15);
+  EXPECT_NEAR(circled.y - circled_plain.y, expected_circled.y(), 1e-15);
+  // Not while driving, nor in the step that stops or starts the driving.
+  for (const std::vector<Twist2>& driving :
+       {std::vector<Twist2>{{0.5, 0.5}, {0.5, 0.0}}, std::vector<Twist2>{{0.5, 0.0}, {0.0, 0.5}},
+        std::vector<Twist2>{{0.0, 0.5}, {0.5, 0.0}}}) {
+    const Pose2 a = PoseAfter(offset, driving);
+    const Pose2 b = PoseAfter(params, driving);
+    const double first_shift = driving[0].v_mps == 0.0 ? 0.0005 : 0.0;  // from rest, on the spot
+    EXPECT_NEAR(std::hypot(a.x - b.x, a.y - b.y), first_shift, 1e-15);
+  }
+  // With odometry the command is not the robot's turn rate: no offset.
+  params.input = offset.input = "odometry";
+  params.odometry_noise = offset.odometry_noise = OdometryNoiseParams{0.0, 0.0, 0.0, 0.0, 0.0};
+  const Pose2 a = PoseAfter(offset, spot);
+  const Pose2 b = PoseAfter(params, spot);
+  EXPECT_EQ(a.x, b.x);
+  EXPECT_EQ(a.y, b.y);
 }
 
 TEST(EkfSlamTest, PredictsFromOdometry) {

@@ -367,6 +367,80 @@ TEST(MotionModelTest, JacobiansAAndWMatchCentralDifferences) {
   }
 }
 
+TEST(MotionModelTest, TurnAboutAPointBesideTheAxle) {
+  // On the spot (d = 0) from heading 0.3 by dth = 0.2, a = 0.2: the axle,
+  // 3 cm left of the point it turns about at the start and 5 cm at the end
+  // (TurnCentre), ends 5 cm left of that point, which stays where it was.
+  const Eigen::Vector3d pose(1.0, 2.0, 0.3);
+  const double a = 0.2;
+  const auto forward = [](double th) { return Eigen::Vector2d(std::cos(th), std::sin(th)); };
+  const auto left = [](double th) { return Eigen::Vector2d(-std::sin(th), std::cos(th)); };
+  const TurnCentre centre{0.05, 0.03};
+  const Eigen::Vector3d spun = PredictPose(pose, Eigen::Vector2d(0.0, 0.2), a, nullptr, nullptr,
+                                           0.0, MotionIntegration::kExact, centre);
+  const Eigen::Vector2d point = pose.head<2>() - a * forward(0.3) - 0.03 * left(0.3);
+  const Eigen::Vector2d expected = point + 0.05 * left(0.5) + a * forward(0.5);
+  EXPECT_NEAR(spun.x(), expected.x(), 1e-15);
+  EXPECT_NEAR(spun.y(), expected.y(), 1e-15);
+  EXPECT_NEAR(spun.z(), 0.5, 1e-15);
+  // Held (offset 0.05 at both ends): the axle circles the point, moving by
+  // 2 * 0.05 sin(0.1) backward along the mid-arc heading 0.4.
+  const Eigen::Vector3d held = PredictPose(pose, Eigen::Vector2d(0.0, 0.2), a, nullptr, nullptr,
+                                           0.0, MotionIntegration::kExact, {0.05, 0.05});
+  const Eigen::Vector3d plain = PredictPose(pose, Eigen::Vector2d(0.0, 0.2), a);
+  const Eigen::Vector2d creep = (held - plain).head<2>();
+  EXPECT_NEAR(creep.x(), -0.1 * std::sin(0.1) * std::cos(0.4), 1e-15);
+  EXPECT_NEAR(creep.y(), -0.1 * std::sin(0.1) * std::sin(0.4), 1e-15);
+  // Driving too, the two motions add: the arc's and the axle's about the point.
+  const Eigen::Vector2d increment(0.3, -0.15);
+  const Eigen::Vector3d both = PredictPose(pose, increment, a, nullptr, nullptr, 0.0,
+                                           MotionIntegration::kExact, centre);
+  const Eigen::Vector2d added = PredictPose(pose, increment, a).head<2>() +
+                                0.05 * left(0.15) - 0.03 * left(0.3);
+  EXPECT_NEAR(both.x(), added.x(), 1e-15);
+  EXPECT_NEAR(both.y(), added.y(), 1e-15);
+  // Euler: the same to first order in dth, across and along the start heading.
+  const Eigen::Vector3d euler = PredictPose(pose, increment, a, nullptr, nullptr, 0.0,
+                                            MotionIntegration::kEuler, centre);
+  const Eigen::Vector2d euler_expected =
+      PredictPose(pose, increment, a, nullptr, nullptr, 0.0, MotionIntegration::kEuler)
+          .head<2>() +
+      (0.05 - 0.03) * left(0.3) - 0.05 * -0.15 * forward(0.3);
+  EXPECT_NEAR(euler.x(), euler_expected.x(), 1e-15);
+  EXPECT_NEAR(euler.y(), euler_expected.y(), 1e-15);
+}
+
+TEST(MotionModelTest, TurnCentreJacobiansMatchCentralDifferences) {
+  for (const MotionIntegration integration :
+       {MotionIntegration::kExact, MotionIntegration::kEuler}) {
+    SCOPED_TRACE(integration == MotionIntegration::kEuler ? "euler" : "exact");
+    Rng rng(17);
+    for (int trial = 0; trial < 100; ++trial) {
+      const Eigen::Vector3d pose = RandomPose(&rng);
+      // On the spot and driving, turns up to about 1 rad a step.
+      const Eigen::Vector2d increment(trial % 2 == 0 ? 0.0 : rng.Gaussian(0.0, 0.5),
+                                      rng.Gaussian(0.0, 0.5));
+      const double a = 0.05 + 0.3 * rng.Uniform();
+      const TurnCentre centre{rng.Gaussian(0.0, 0.1), rng.Gaussian(0.0, 0.1)};
+      Eigen::Matrix3d A;
+      Eigen::Matrix<double, 3, 2> W;
+      PredictPose(pose, increment, a, &A, &W, 0.0, integration, centre);
+      const Eigen::Matrix3d numerical_A = NumericalJacobian<3, 3>(
+          [&](const Eigen::Vector3d& p) {
+            return PredictPose(p, increment, a, nullptr, nullptr, 0.0, integration, centre);
+          },
+          pose, {2});
+      const Eigen::Matrix<double, 3, 2> numerical_W = NumericalJacobian<3, 2>(
+          [&](const Eigen::Vector2d& u) {
+            return PredictPose(pose, u, a, nullptr, nullptr, 0.0, integration, centre);
+          },
+          increment, {2});
+      EXPECT_LT((A - numerical_A).cwiseAbs().maxCoeff(), kJacobianTolerance) << "trial " << trial;
+      EXPECT_LT((W - numerical_W).cwiseAbs().maxCoeff(), kJacobianTolerance) << "trial " << trial;
+    }
+  }
+}
+
 // The command noise of the CommandInput tests: 0.02 m/s + 10 %, 0.01 rad/s +
 // 20 %, half the command's change.
 CommandNoiseParams TestCommandNoise() {
@@ -436,6 +510,24 @@ TEST(MotionModelTest, SettleNoiseFollowsThePreviousChange) {
   noise.settle_noise_fraction = -0.1;
   ASSERT_EQ(noise.Validate().size(), 1u);
   EXPECT_EQ(noise.Validate()[0].key, "settle_noise_fraction");
+}
+
+TEST(MotionModelTest, LagNoiseFollowsTheGapToTheCommand) {
+  CommandNoiseParams noise = TestCommandNoise();
+  noise.lag_noise_fraction = 0.5;
+  // The wheels at (0.3, -0.1) catching up with the command (0.5, -0.4) held
+  // since the record before: sigma grows by 0.5 of the gap, 0.1 and 0.15.
+  const Twist2 command{0.5, -0.4};
+  const Twist2 followed{0.3, -0.1};
+  const MotionInput catching_up = CommandInput(command, 0.2, noise, command, 1.0, 1.0, &followed);
+  EXPECT_NEAR(std::sqrt(catching_up.covariance(0, 0)), 0.2 * (0.02 + 0.03 + 0.1), 1e-12);
+  EXPECT_NEAR(std::sqrt(catching_up.covariance(1, 1)), 0.2 * (0.01 + 0.02 + 0.15), 1e-12);
+  // Caught up (or no lag): no such term.
+  const MotionInput caught_up = CommandInput(command, 0.2, noise, command, 1.0, 1.0, &command);
+  EXPECT_NEAR(std::sqrt(caught_up.covariance(0, 0)), 0.2 * (0.02 + 0.05), 1e-12);
+  noise.lag_noise_fraction = -0.1;
+  ASSERT_EQ(noise.Validate().size(), 1u);
+  EXPECT_EQ(noise.Validate()[0].key, "lag_noise_fraction");
 }
 
 TEST(MotionModelTest, OdometryInputIsTheIncrementInThePreviousFrame) {
