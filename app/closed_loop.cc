@@ -252,9 +252,14 @@ void ClosedLoop::Advance() {
     World& w = *world_;
     const double disturbance = config_.sim.drive_disturbance_std_fraction;
     if (disturbance > 0.0) {
-      const double e_v = w.drive_rng.Gaussian(0.0, disturbance);
-      const double e_w = w.drive_rng.Gaussian(0.0, disturbance);
-      w.simulator.SetDriveFactors(1.0 + e_v, 1.0 + e_w);
+      // Two draws a step: (e_v, e_w) of the twist or (e_left, e_right).
+      const double e_1 = w.drive_rng.Gaussian(0.0, disturbance);
+      const double e_2 = w.drive_rng.Gaussian(0.0, disturbance);
+      if (config_.sim.drive_disturbance == "wheels") {
+        w.simulator.SetWheelFactors(1.0 + e_1, 1.0 + e_2);
+      } else {
+        w.simulator.SetDriveFactors(1.0 + e_1, 1.0 + e_2);
+      }
     }
     w.simulator.Advance(dt_s_);
     const int contacts = w.simulator.CountRobotWorldContacts();

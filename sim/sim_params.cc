@@ -14,6 +14,7 @@ std::vector<ParamProblem> SimParams::Validate() const {
   check.NonNegative("wheel_speed_ki_nm_per_rad", wheel_speed_ki_nm_per_rad);
   // Beyond a third, 1 + e would often be negative: the wheels would turn backwards.
   check.InRange("drive_disturbance_std_fraction", drive_disturbance_std_fraction, 0.0, 0.3);
+  check.OneOf("drive_disturbance", drive_disturbance, {"twist", "wheels"});
   return check.problems();
 }
 

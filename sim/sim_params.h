@@ -1,5 +1,6 @@
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "common/params.h"
@@ -37,6 +38,15 @@ struct SimParams {
   /// deterministic function of its commands, the same in every run that
   /// issues the same commands.
   double drive_disturbance_std_fraction = 0.0;
+  /// What that disturbance scales: "twist" (the default) the command's v and
+  /// w, each by its own factor, as above; "wheels" each wheel's set point,
+  /// left and right by their own factors 1 + e_left, 1 + e_right (drawn in
+  /// that order from the same stream), as each wheel's motor controller,
+  /// tyre and floor contact vary on their own: then a turn on the spot also
+  /// moves the robot forward or back, and driving straight also turns it,
+  /// which the twist's factors never do (docs/method.md, "Calibrating the
+  /// process noise").
+  std::string drive_disturbance = "twist";
 
   template <typename Archive>
   void Serialize(Archive* a) {
@@ -45,6 +55,7 @@ struct SimParams {
     a->Visit(MJSLAM_NVP(wheel_speed_kp_nms_per_rad));
     a->Visit(MJSLAM_NVP(wheel_speed_ki_nm_per_rad));
     a->Visit(MJSLAM_NVP(drive_disturbance_std_fraction));
+    a->Visit(MJSLAM_NVP(drive_disturbance));
   }
   std::vector<ParamProblem> Validate() const;
   void ValidateOrThrow() const { ThrowIfProblems(Validate()); }

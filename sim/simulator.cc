@@ -105,6 +105,8 @@ struct Simulator::Impl {
   Twist2 command;
   // The drive's disturbance: the set points are those of (v v, w w) of these.
   Twist2 drive_factors{1.0, 1.0};
+  // Each wheel's disturbance: its set point times these (left, right).
+  std::array<double, 2> wheel_factors{1.0, 1.0};
   // Wheel-speed controller: set points (rad/s) and integrated errors (rad).
   std::array<double, 2> speed_setpoint_radps{0.0, 0.0};
   std::array<double, 2> speed_error_integral_rad{0.0, 0.0};
@@ -135,7 +137,8 @@ struct Simulator::Impl {
   void ApplySetPoints() {
     const Twist2 asked{command.v_mps * drive_factors.v_mps, command.w_radps * drive_factors.w_radps};
     const WheelSpeeds wheels = WheelSpeedsFromTwist(asked, robot);
-    speed_setpoint_radps = {wheels.left_radps, wheels.right_radps};
+    speed_setpoint_radps = {wheels.left_radps * wheel_factors[0],
+                            wheels.right_radps * wheel_factors[1]};
   }
 
   Pose2 X_WA() const {
@@ -362,6 +365,12 @@ Twist2 Simulator::SetCommand(const Twist2& command) {
 void Simulator::SetDriveFactors(double v_factor, double w_factor) {
   MJSLAM_CHECK(std::isfinite(v_factor) && std::isfinite(w_factor));
   impl_->drive_factors = Twist2{v_factor, w_factor};
+  impl_->ApplySetPoints();
+}
+
+void Simulator::SetWheelFactors(double left_factor, double right_factor) {
+  MJSLAM_CHECK(std::isfinite(left_factor) && std::isfinite(right_factor));
+  impl_->wheel_factors = {left_factor, right_factor};
   impl_->ApplySetPoints();
 }
 

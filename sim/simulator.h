@@ -65,6 +65,13 @@ class Simulator {
   /// SimParams::drive_disturbance_std_fraction. Both must be finite (checked).
   void SetDriveFactors(double v_factor, double w_factor);
 
+  /// Disturbs the drive wheel by wheel: from now on each wheel's speed set
+  /// point is scaled by its factor (after those of SetDriveFactors), until
+  /// the next call. Factors 1 (the initial ones) leave the set points exact;
+  /// the closed loop draws them with SimParams::drive_disturbance "wheels".
+  /// Both must be finite (checked).
+  void SetWheelFactors(double left_factor, double right_factor);
+
   /// Advances the physics by whole timesteps: after the call the simulated
   /// time is the multiple of the timestep nearest to the sum of all durations
   /// requested so far (so ten Advance(0.1) make exactly 1 s). Throws SimError

@@ -144,13 +144,15 @@ MotionInput CommandInput(const Twist2& command, double dt_s, const CommandNoiseP
       (noise.v_noise_std_mps + noise.v_noise_fraction * std::abs(speeds.v_mps) +
        noise.change_noise_fraction * std::abs(command.v_mps - previous.v_mps) +
        noise.settle_noise_fraction * std::abs(previous_change.v_mps) +
-       noise.lag_noise_fraction * std::abs(command.v_mps - speeds.v_mps));
+       noise.lag_noise_fraction * std::abs(command.v_mps - speeds.v_mps) +
+       noise.turn_v_noise_m_per_rad * std::abs(speeds.w_radps));
   const double sigma_w =
       noise.w_noise_scale *
       (noise.w_noise_std_radps + noise.w_noise_fraction * std::abs(speeds.w_radps) +
        noise.change_noise_fraction * std::abs(command.w_radps - previous.w_radps) +
        noise.settle_noise_fraction * std::abs(previous_change.w_radps) +
-       noise.lag_noise_fraction * std::abs(command.w_radps - speeds.w_radps));
+       noise.lag_noise_fraction * std::abs(command.w_radps - speeds.w_radps) +
+       noise.speed_w_noise_rad_per_m * std::abs(speeds.v_mps));
   input.covariance = Eigen::Vector2d(dt_s * dt_s * sigma_v * sigma_v,
                                      dt_s * dt_s * sigma_w * sigma_w)
                          .asDiagonal();

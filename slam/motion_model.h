@@ -81,7 +81,10 @@ Twist2 FollowCommand(const Twist2& followed, const Twist2& command, double dt_s,
 ///   sigma_v = v_noise_scale (v_noise_std_mps + v_noise_fraction |v|
 ///             + change_noise_fraction |command.v - previous.v|
 ///             + settle_noise_fraction |previous_change.v|
-///             + lag_noise_fraction |command.v - v|)   (likewise w),
+///             + lag_noise_fraction |command.v - v|
+///             + turn_v_noise_m_per_rad |w|),
+/// sigma_w likewise with w for v and speed_w_noise_rad_per_m |v| in place
+/// of the last term,
 /// `previous` being the command of the record before and `previous_change`
 /// the change of the command at that record (its command less the one
 /// before it; zero at the first records) (CommandNoiseParams).

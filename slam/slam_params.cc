@@ -44,6 +44,8 @@ std::vector<ParamProblem> CommandNoiseParams::Validate() const {
   check.NonNegative("change_noise_fraction", change_noise_fraction);
   check.NonNegative("settle_noise_fraction", settle_noise_fraction);
   check.NonNegative("lag_noise_fraction", lag_noise_fraction);
+  check.NonNegative("turn_v_noise_m_per_rad", turn_v_noise_m_per_rad);
+  check.NonNegative("speed_w_noise_rad_per_m", speed_w_noise_rad_per_m);
   check.Positive("v_noise_scale", v_noise_scale);
   check.Positive("w_noise_scale", w_noise_scale);
   // A zero constant part would make a stopped robot's prediction exact.

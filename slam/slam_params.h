@@ -98,6 +98,15 @@ struct CommandNoiseParams {
   /// change, a start or a stop move in ways the first-order lag follows only
   /// roughly (docs/method.md, departure 25). 0 (the default): no such term.
   double lag_noise_fraction = 0.0;
+  /// Part of the speed noise sigma_v proportional to the turn rate |w|
+  /// (m/s per rad/s): each wheel's own variation moves a turning robot
+  /// forward or back, even on the spot (docs/method.md, departure 26).
+  /// 0 (the default): no such term.
+  double turn_v_noise_m_per_rad = 0.0;
+  /// Part of the turn-rate noise sigma_w proportional to the speed |v|
+  /// (rad/s per m/s): each wheel's own variation turns a robot that drives
+  /// straight (departure 26). 0 (the default): no such term.
+  double speed_w_noise_rad_per_m = 0.0;
   /// Factor on the whole of sigma_v (dimensionless, > 0): the fitted shape
   /// above kept, its size set against the filters' consistency on training
   /// runs (scripts/calibrate_noise.py --nees; docs/method.md, "Calibrating the
@@ -115,6 +124,8 @@ struct CommandNoiseParams {
     a->Visit(MJSLAM_NVP(change_noise_fraction));
     a->Visit(MJSLAM_NVP(settle_noise_fraction));
     a->Visit(MJSLAM_NVP(lag_noise_fraction));
+    a->Visit(MJSLAM_NVP(turn_v_noise_m_per_rad));
+    a->Visit(MJSLAM_NVP(speed_w_noise_rad_per_m));
     a->Visit(MJSLAM_NVP(v_noise_scale));
     a->Visit(MJSLAM_NVP(w_noise_scale));
   }

@@ -219,4 +219,26 @@ TEST(ClosedLoopTest, TheDrivesVariationFollowsTheRunSeed) {
   EXPECT_NE(true_path(1, 0.01), true_path(1, 0.0));
 }
 
+// The wheels' disturbance (sim.drive_disturbance: wheels) is drawn from the
+// same stream, so it too follows the seed; it is not the twist's.
+TEST(ClosedLoopTest, TheWheelsVariationFollowsTheRunSeed) {
+  auto true_path = [](std::uint64_t seed, const std::string& disturbance) {
+    RunConfig config = ShortConfig({"control.pose_source=odometry", "laser.range_noise_std_m=0",
+                                    "odometry.slip_std_fraction=0",
+                                    "sim.drive_disturbance_std_fraction=0.01",
+                                    "sim.drive_disturbance=" + disturbance});
+    config.run.seed = seed;
+    ClosedLoop loop(config);
+    std::vector<double> path;
+    while (!loop.Done()) {
+      const rundir::TrajectoryRow& row = loop.Step().row;
+      path.insert(path.end(), {row.X_WR_true.x, row.X_WR_true.y, row.X_WR_true.theta});
+    }
+    return path;
+  };
+  EXPECT_EQ(true_path(1, "wheels"), true_path(1, "wheels"));
+  EXPECT_NE(true_path(1, "wheels"), true_path(2, "wheels"));
+  EXPECT_NE(true_path(1, "wheels"), true_path(1, "twist"));
+}
+
 }  // namespace mjslam::app

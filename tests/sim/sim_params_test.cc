@@ -56,7 +56,8 @@ TEST(SimParamsTest, SerializeVisitsEveryFieldUnderItsKey) {
   EXPECT_EQ(Keys<SimParams>(),
             (std::vector<std::string>{"timestep_s", "settle_time_s", "wheel_speed_kp_nms_per_rad",
                                       "wheel_speed_ki_nm_per_rad",
-                                      "drive_disturbance_std_fraction"}));
+                                      "drive_disturbance_std_fraction",
+                                      "drive_disturbance"}));
   EXPECT_EQ(Keys<RobotParams>(),
             (std::vector<std::string>{"control_point_offset_m", "wheel_radius_m", "axle_track_m",
                                       "max_wheel_speed_radps", "max_linear_speed_mps",
@@ -76,9 +77,10 @@ TEST(SimParamsTest, BadValuesAreReportedUnderTheirKeys) {
   sim.timestep_s = 0.05;
   sim.wheel_speed_kp_nms_per_rad = 0.0;
   sim.drive_disturbance_std_fraction = 0.5;
+  sim.drive_disturbance = "wheel";
   EXPECT_EQ(ProblemKeys(sim.Validate()),
             (std::vector<std::string>{"timestep_s", "wheel_speed_kp_nms_per_rad",
-                                      "drive_disturbance_std_fraction"}));
+                                      "drive_disturbance_std_fraction", "drive_disturbance"}));
 
   RobotParams robot;
   robot.control_point_offset_m = 0.0;

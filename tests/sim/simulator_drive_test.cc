@@ -93,6 +93,29 @@ TEST_F(SimulatorDriveTest, DriveFactorsScaleTheSetPointsNotTheCommand) {
   EXPECT_NEAR(disturbed.w_radps / exact.w_radps, 0.9, 0.01);
 }
 
+// Each wheel's own disturbance (SetWheelFactors): on the spot, a right
+// wheel faster than the left one moves the robot forward as it turns, which
+// the twist's factors never do; driving straight, it turns the robot left.
+TEST_F(SimulatorDriveTest, WheelFactorsScaleEachWheelsSetPoint) {
+  const auto drive = [&](const Twist2& command, double left, double right) {
+    Simulator sim(EmptyWorld(), RobotModelPath(), SimParams{}, RobotParams{}, Pose2(0, 0, 0));
+    sim.SetCommand(command);
+    sim.SetWheelFactors(left, right);
+    sim.Advance(2.0);
+    EXPECT_DOUBLE_EQ(sim.command().v_mps, command.v_mps);
+    return sim.TrueTwist();
+  };
+  const RobotParams robot;
+  const double rim = 0.5 * 0.6 * robot.axle_track_m;  // each wheel's speed at 0.6 rad/s, m/s
+  const Twist2 spin = drive({0.0, 0.6}, 0.9, 1.1);
+  EXPECT_NEAR(spin.v_mps, 0.1 * rim, 0.05 * rim);  // (1.1 rim - 0.9 rim) / 2
+  EXPECT_NEAR(spin.w_radps, 0.6, 0.02);
+  EXPECT_NEAR(drive({0.0, 0.6}, 1.0, 1.0).v_mps, 0.0, 1e-3 * rim);
+  const Twist2 straight = drive({0.5, 0.0}, 0.99, 1.01);
+  EXPECT_NEAR(straight.w_radps, 0.01 / robot.axle_track_m, 0.1 * 0.01 / robot.axle_track_m);
+  EXPECT_NEAR(straight.v_mps, 0.5, 0.01);
+}
+
 // Drives straight with `speed` until the point h has covered 5 m; returns the
 // heading change (rad) and the lateral offset (m) from the start line.
 std::pair<double, double> DriveStraightFiveMetres(double speed_mps) {
