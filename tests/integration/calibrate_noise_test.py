@@ -7,9 +7,9 @@ robot whose sideways motion while moving has another form (case `spot`).
 
     /usr/bin/python3 tests/integration/calibrate_noise_test.py SOURCE_DIR [CASE] [OPTION ...]
 
-(CASE `regime` when left out; OPTIONs are passed on to the script.) Three synthetic runs (seeds 1-3, 600 steps of 0.1 s
-each) of a unicycle whose axle centre moves
-at the commands through a first-order lag of tau = 0.05 s, times the gains 0.99 (speed) and 1.01
+(CASE `regime` when left out; OPTIONs are passed on to the script.) Three synthetic runs
+(seeds 1-3, 600 steps of 0.1 s each) of a unicycle whose axle centre moves at the commands
+through a first-order lag of tau = 0.05 s, times the gains 0.99 (speed) and 1.01
 (turn rate), plus white noise of 1 mm/s and 5 mrad/s and, in the period after each change of the
 command, 0.1 of that change (the settling wheels, slam.ekf.command_noise.settle_noise_fraction);
 the robot at rest before the first row; the point R 0.2 m ahead of the axle, as the script
@@ -23,19 +23,18 @@ also grows by LAG_NOISE times the gap between the command and the followed speed
 (slam.ekf.command_noise.lag_noise_fraction), fitted with --lag-noise.
 
 Case `regime` (--slip-by-regime --turn-centre --lag-noise). Asserted: the fitted command_lag_s
-within 0.005 s of 0.05, command_gain_v within 0.002
-of 0.99, command_gain_w within 0.005 of 1.01, settle_noise_fraction within 0.02 of 0.1, each
-slip and the turn centre's offset (fitted from both components together and from each alone:
-the shift at a change and the creep while held) within 20 % of its value, lag_noise_fraction
-within 0.1 of 0.3 (the gap right after a change is 0.135 of the change, so the fit shares it
-with the change term: 0.233 and 0.013 fitted on these runs); the wheels' terms not fitted.
-Shown by hand to fail: with the script's lag left at 0 (--no-lag)
-the gains are still found but the test fails on the lag; with the settle term left out of the
-script's sigmas it fails on it; with the change term left out of fit_slip_by_regime's variance
-it fails on the slips; with the turn centre's motion not taken out of the true steps
-(take_out_turn_centre) it fails on the change's slip, and with the creep (the along
-component) left out of fit_turn_centre on the offset along alone; without --lag-noise on the
-lag term (0 fitted).
+within 0.005 s of 0.05, command_gain_v within 0.002 of 0.99, command_gain_w within 0.005 of
+1.01, settle_noise_fraction within 0.02 of 0.1, each slip and the turn centre's offset (fitted
+from both components together and from each alone: the shift at a change and the creep while
+held) within 20 % of its value, lag_noise_fraction within 0.1 of 0.3 (the gap right after a
+change is 0.135 of the change, so the fit shares it with the change term: 0.233 and 0.013 fitted
+on these runs); the wheels' terms not fitted. Shown by hand to fail: with the script's lag left
+at 0 (--no-lag) the gains are still found but the test fails on the lag; with the settle term
+left out of the script's sigmas it fails on it; with the change term left out of
+fit_slip_by_regime's variance it fails on the slips; with the turn centre's motion not taken out
+of the true steps (take_out_turn_centre) it fails on the change's slip, and with the creep (the
+along component) left out of fit_turn_centre on the offset along alone; without --lag-noise on
+the lag term (0 fitted).
 
 Case `wheels` (--slip-by-regime --turn-centre --wheel-noise; not --lag-noise: with the wheels'
 terms the fit gives the lag term's share to the change term, so the lag term is not asserted):
