@@ -5,9 +5,11 @@ slam.ekf.lateral_skid_s, slam.ekf.lateral_slip_std_m_per_rad (and by regime) and
 slam.ekf.turn_centre_offset_m_per_radps (docs/method.md, "Calibrating the process noise").
 
     scripts/calibrate_noise.py DIR [DIR ...] [--offset A] [--window L] [--no-gain] [--no-lag]
-                               [--slip-by-regime] [--turn-centre] [--json FILE]
+                               [--slip-by-regime | --slip-on-the-spot] [--turn-centre]
+                               [--lag-noise] [--wheel-noise] [--json FILE]
     scripts/calibrate_noise.py --consistency WORK --write CONFIG [--config BASE] [--seed S]
                                [--runs N] [--jobs J] [--iterations K] [--tolerance T]
+                               [--slip-on-the-spot] [--wheel-noise]
 
 Each DIR is a run directory (with trajectory.csv) or a sweep directory (its
 runs/run_*/ are taken). For every step k of a trajectory (rows k-1 and k,
@@ -25,8 +27,13 @@ an arc along the mid-arc heading, plus a sideways skid):
   by the gains g_v and g_w (slam.ekf.command_gain_v, _w: the
   robot's mean speed over its command), its noise growing with the change
   from the command of row k-2 and with the change one row earlier (row k-2
-  from row k-3: the wheels still settling), and with --lag-noise with the gap
-  between the command and the followed speed (lag_noise_fraction). The errors e_v = d / dt - g_v v_f and
+  from row k-3: the wheels still settling), with --lag-noise with the gap
+  between the command and the followed speed (lag_noise_fraction), and with
+  --wheel-noise (wheels that vary each on its own, departure 26) the speed's
+  with the turn rate followed and the turn rate's with the speed followed
+  (turn_v_noise_m_per_rad |w_f| in sigma_v, speed_w_noise_rad_per_m |v_f|
+  in sigma_w; appended to the constants, after lag_noise_fraction, which is
+  held at 0 without --lag-noise). The errors e_v = d / dt - g_v v_f and
   e_w = dth / dt - g_w w_f (v_f, w_f the speeds followed) of the true increment (d, dth) are modelled as
   independent zero-mean Gaussians with
       sigma_v = v_noise_std_mps + v_noise_fraction |v_f| + change_noise_fraction |v - v_prev|
@@ -53,7 +60,12 @@ an arc along the mid-arc heading, plus a sideways skid):
   --slip-by-regime, instead, the slip per radian on the spot, its growth with
   the speed and the slip at a change of the turn rate
   (lateral_slip_std_m_per_rad, _per_rad_per_mps, _per_radps_change;
-  docs/method.md, departure 23), by maximum likelihood (fit_slip_by_regime).
+  docs/method.md, departure 23), by maximum likelihood (fit_slip_by_regime);
+  with --slip-on-the-spot the slip per radian and at a change of the turn
+  rate by maximum likelihood over the steps on the spot only, its growth
+  with the speed 0 (fit_slip_on_the_spot): moving, what is left sideways
+  is not per radian turned; the moving steps' rms and the model's are
+  printed.
 - turn centre (--turn-centre): on the spot (the command and the one before
   with v = 0) the robot turns about a point s w beside its axle
   (turn_centre_offset_m_per_radps, departure 24; slam::TurnCentre): the axle
@@ -75,7 +87,8 @@ from the true motion leaves the filters overconfident, because the linearised
 EKF gains information from its corrections that it does not have
 (docs/method.md, "Calibrating the process noise"). This mode runs the whole
 procedure: a training sweep with --config (WORK/motion: --runs runs from
---seed), the fit above on it, then sweeps of the same seeds with the fitted
+--seed), the fit above on it (with --wheel-noise and --slip-on-the-spot if
+given), then sweeps of the same seeds with the fitted
 model (WORK/scale_N) that set the two factors
 slam.ekf.command_noise.v_noise_scale and w_noise_scale so that the training
 runs' mean pose NEES per component is its dof: the position's (x, y; 2 dof)
@@ -230,14 +243,21 @@ def gaussian_nll(errors_and_variances):
 
 def command_sigmas(s, p):
     """(sigma_v, sigma_w) of CommandInput for step s, p = (v0, kv, w0, kw, kc,
-    ks[, kl]): ks the settle term's fraction (0 when p has five values), kl
-    the lag term's (of the gap between the command and the followed speed;
-    0 when p has six values)."""
+    ks[, kl[, tv, sw]]) in the order of COMMAND_NAMES: ks the settle term's
+    fraction (0 when p has five values), kl the lag term's (of the gap between
+    the command and the followed speed; 0 when p has six values), tv and sw
+    the wheels' terms (turn_v_noise_m_per_rad, of |fw| in sigma_v, and
+    speed_w_noise_rad_per_m, of |fv| in sigma_w; 0 when p has seven values
+    or fewer)."""
     v0, kv, w0, kw, kc = p[:5]
     ks = p[5] if len(p) > 5 else 0.0
     kl = p[6] if len(p) > 6 else 0.0
-    return (v0 + kv * abs(s["fv"]) + kc * s["dv"] + ks * s["dv1"] + kl * abs(s["v"] - s["fv"]),
-            w0 + kw * abs(s["fw"]) + kc * s["dw"] + ks * s["dw1"] + kl * abs(s["w"] - s["fw"]))
+    tv = p[7] if len(p) > 7 else 0.0
+    sw = p[8] if len(p) > 8 else 0.0
+    return (v0 + kv * abs(s["fv"]) + kc * s["dv"] + ks * s["dv1"] + kl * abs(s["v"] - s["fv"])
+            + tv * abs(s["fw"]),
+            w0 + kw * abs(s["fw"]) + kc * s["dw"] + ks * s["dw1"] + kl * abs(s["w"] - s["fw"])
+            + sw * abs(s["fv"]))
 
 
 def command_errors(s, gains=(1.0, 1.0)):
@@ -351,22 +371,34 @@ def window_pairs(windows, p, gains=(1.0, 1.0)):
     return pairs
 
 
-def fit_command(runs_steps, window, with_gains=True, rounds=3, lag_noise=False):
+def fit_command(runs_steps, window, with_gains=True, rounds=3, lag_noise=False,
+                wheel_noise=False):
     """(CommandNoiseParams, (g_v, g_w, se_v, se_w)) by maximum likelihood of
     the increments' errors summed over windows of `window` steps (1: every
     step on its own); the gains 1 when not `with_gains`; with `lag_noise`
-    also the lag term's fraction (lag_noise_fraction, the seventh value)."""
+    also the lag term's fraction (lag_noise_fraction, the seventh value);
+    with `wheel_noise` also the wheels' terms (turn_v_noise_m_per_rad and
+    speed_w_noise_rad_per_m, the eighth and ninth values; the seventh is then
+    0 when not `lag_noise`, and not fitted)."""
     windows = windows_of(runs_steps, window)
     steps = [s for run_steps in runs_steps for s in run_steps]
     gains = (1.0, 1.0, 0.0, 0.0)
     p = [0.01, 0.05, 0.01, 0.05, 0.3, 0.1] + ([0.1] if lag_noise else [])
+    if wheel_noise:
+        p += [1e-3, 1e-2]
+
+    def full(q):
+        """The fitted constants q as command_sigmas' p (the lag term's 0
+        before the wheels' terms where it is not fitted)."""
+        return q[:6] + [0.0] + q[6:] if wheel_noise and not lag_noise else q
+
     for _ in range(rounds if with_gains else 1):
-        p = fit(lambda q: gaussian_nll(window_pairs(windows, q, gains[:2])), p)
+        p = fit(lambda q: gaussian_nll(window_pairs(windows, full(q), gains[:2])), p)
         if with_gains:
-            gains = fit_gains(steps, p)
+            gains = fit_gains(steps, full(p))
     if with_gains:
-        p = fit(lambda q: gaussian_nll(window_pairs(windows, q, gains[:2])), p)
-    return p, gains
+        p = fit(lambda q: gaussian_nll(window_pairs(windows, full(q), gains[:2])), p)
+    return full(p), gains
 
 
 def variance_ratios(runs_steps, p, lengths, gains=(1.0, 1.0)):
@@ -506,6 +538,42 @@ def fit_slip_by_regime(steps, c, gain_v):
     return fit(nll, [1e-4, 1e-3, 1e-4])
 
 
+def fit_slip_on_the_spot(steps, c):
+    """(k0, kc, ratio, moving_rms, moving_model_rms): the sideways slip
+    fitted on the spot only (--slip-on-the-spot), by maximum likelihood to
+    what the skid c leaves, r, on the steps on the spot (the command and the
+    one before with v = 0) with a turn or a change of the turn rate, modelled
+    as a zero-mean Gaussian with variance
+        (k0 dth)^2 + (kc |w - w_prev|)^2
+    (slam.ekf.lateral_slip_std_m_per_rad, _per_radps_change; the growth with
+    the speed, _per_rad_per_mps, 0). Moving, what is left sideways is not per
+    radian turned, so those steps are left out of the fit; `ratio` is the
+    fitted steps' mean r^2 / variance (1 where the model fits), `moving_rms`
+    the root mean square of r over the moving steps and `moving_model_rms`
+    the root of the mean variance the model gives them."""
+    rows = []
+    for s in steps:
+        if s["on_the_spot"] and (s["dth"] != 0.0 or s["dw"] != 0.0):
+            rows.append((sideways_residual(s, c), s["dth"] ** 2, s["dw"] ** 2))
+    if not rows:
+        raise ValueError("no turn and no change of the turn rate on the spot: the slip on the "
+                         "spot is undetermined")
+
+    def nll(p):
+        k0, kc = p
+        return gaussian_nll((r, k0 * k0 * t + kc * kc * w) for r, t, w in rows)
+
+    k0, kc = fit(nll, [1e-4, 1e-4])
+    ratio = sum(r * r / (k0 * k0 * t + kc * kc * w) for r, t, w in rows) / len(rows)
+    moving = [s for s in steps if not s["on_the_spot"]]
+    if not moving:
+        return k0, kc, ratio, 0.0, 0.0
+    moving_rms = math.sqrt(sum(sideways_residual(s, c) ** 2 for s in moving) / len(moving))
+    model_rms = math.sqrt(sum((k0 * s["dth"]) ** 2 + (kc * s["dw"]) ** 2 for s in moving)
+                          / len(moving))
+    return k0, kc, ratio, moving_rms, model_rms
+
+
 def print_bins(title, steps, key, edges, normalised):
     """Mean of the squared normalised errors over bins of s[key]."""
     print(f"  {title}:")
@@ -531,16 +599,25 @@ def read_runs(dirs, offset):
 
 
 COMMAND_NAMES = ["v_noise_std_mps", "v_noise_fraction", "w_noise_std_radps", "w_noise_fraction",
-                 "change_noise_fraction", "settle_noise_fraction", "lag_noise_fraction"]
+                 "change_noise_fraction", "settle_noise_fraction", "lag_noise_fraction",
+                 "turn_v_noise_m_per_rad", "speed_w_noise_rad_per_m"]
 ODOMETRY_NAMES = ["distance_noise_std_m", "distance_noise_std_m_per_sqrt_m",
                   "heading_noise_std_rad", "heading_noise_std_rad_per_sqrt_m",
                   "heading_noise_std_rad_per_sqrt_rad"]
 
 
-def ekf_values(gains, lag, command, odometry, c, k):
+def command_noise(command, lag_noise):
+    """The fitted constants of fit_command's `command` as the keys of
+    slam.ekf.command_noise: lag_noise_fraction only when fitted (`lag_noise`;
+    fit_command holds it at 0 before the wheels' terms otherwise)."""
+    return {name: value for name, value in zip(COMMAND_NAMES, command)
+            if name != "lag_noise_fraction" or lag_noise}
+
+
+def ekf_values(gains, lag, command, odometry, c, k, lag_noise):
     """The fitted values as the keys of slam.ekf (nested dicts)."""
     return {"command_gain_v": gains[0], "command_gain_w": gains[1], "command_lag_s": lag,
-            "command_noise": dict(zip(COMMAND_NAMES, command)),
+            "command_noise": command_noise(command, lag_noise),
             "odometry_noise": dict(zip(ODOMETRY_NAMES, odometry)),
             "lateral_skid_s": c, "lateral_slip_std_m_per_rad": k}
 
@@ -641,8 +718,12 @@ def consistency(args):
     runs_steps, steps, c, k = read_runs([motion], args.offset)
     lag = fit_lag(runs_steps)
     apply_lag(runs_steps, lag)
-    command, gains = fit_command(runs_steps, 1, True)
-    values = ekf_values(gains, lag, command, fit_odometry(steps), c, k)
+    command, gains = fit_command(runs_steps, 1, True, wheel_noise=args.wheel_noise)
+    values = ekf_values(gains, lag, command, fit_odometry(steps), c, k, False)
+    if args.slip_on_the_spot:
+        k0, kc = fit_slip_on_the_spot(steps, c)[:2]
+        values.update(lateral_slip_std_m_per_rad=k0, lateral_slip_std_m_per_rad_per_mps=0.0,
+                      lateral_slip_std_m_per_radps_change=kc)
     scale_v = scale_w = 1.0
     history = []
     for iteration in range(args.iterations):
@@ -679,10 +760,20 @@ def main():
                         help="keep the command gains at 1 (fit the noise only)")
     parser.add_argument("--no-lag", action="store_true",
                         help="no lag of the wheels behind the command (command_lag_s 0)")
-    parser.add_argument("--slip-by-regime", action="store_true",
-                        help="fit the sideways slip per radian turned on the spot, its growth "
-                             "with the speed and its jolt at a change of the turn rate "
-                             "(fit_slip_by_regime) instead of one value per radian")
+    slip = parser.add_mutually_exclusive_group()
+    slip.add_argument("--slip-by-regime", action="store_true",
+                      help="fit the sideways slip per radian turned on the spot, its growth "
+                           "with the speed and its jolt at a change of the turn rate "
+                           "(fit_slip_by_regime) instead of one value per radian")
+    slip.add_argument("--slip-on-the-spot", action="store_true",
+                      help="fit the sideways slip per radian turned and at a change of the turn "
+                           "rate on the spot only, its growth with the speed 0 "
+                           "(fit_slip_on_the_spot; also with --consistency)")
+    parser.add_argument("--wheel-noise", action="store_true",
+                        help="also fit the command noise of wheels that vary each on its own: "
+                             "the speed's growing with the turn rate and the turn rate's with "
+                             "the speed (command_noise.turn_v_noise_m_per_rad, "
+                             "speed_w_noise_rad_per_m; also with --consistency)")
     parser.add_argument("--turn-centre", action="store_true",
                         help="fit the point beside the axle the robot turns about on the spot "
                              "(fit_turn_centre) and take its motion out of the true steps "
@@ -751,7 +842,7 @@ def main():
         take_out_turn_centre(steps, turn_centre[0])
         c, k = fit_skid(steps)
     command, gains = fit_command(runs_steps, args.window, not args.no_gain,
-                                 lag_noise=args.lag_noise)
+                                 lag_noise=args.lag_noise, wheel_noise=args.wheel_noise)
 
     print(f"# scripts/calibrate_noise.py: {len(steps)} steps from {len(runs)} runs")
     print("slam:\n  ekf:")
@@ -759,13 +850,22 @@ def main():
     print(f"    command_gain_w: {gains[1]:.6g}   # standard error {gains[3]:.2g}")
     print(f"    command_lag_s: {lag:.4g}")
     print("    command_noise:")
-    for name, value in zip(COMMAND_NAMES, command):
+    for name, value in command_noise(command, args.lag_noise).items():
         print(f"      {name}: {value:.4g}")
     print("    odometry_noise:")
     for name, value in zip(ODOMETRY_NAMES, odometry):
         print(f"      {name}: {value:.4g}")
     print(f"    lateral_skid_s: {c:.4g}")
-    slip = fit_slip_by_regime(steps, c, gains[0]) if args.slip_by_regime else None
+    slip = spot = None
+    if args.slip_by_regime:
+        slip = fit_slip_by_regime(steps, c, gains[0])
+    elif args.slip_on_the_spot:
+        try:
+            spot = fit_slip_on_the_spot(steps, c)
+        except ValueError as e:
+            print(f"calibrate_noise: {e}", file=sys.stderr)
+            return 2
+        slip = (spot[0], 0.0, spot[1])
     if turn_centre:
         print(f"    turn_centre_offset_m_per_radps: {turn_centre[0]:.4g}   # along alone "
               f"{turn_centre[1]:.4g}, across alone {turn_centre[2]:.4g}")
@@ -776,6 +876,10 @@ def main():
         print(f"    lateral_slip_std_m_per_radps_change: {kc:.4g}")
     else:
         print(f"    lateral_slip_std_m_per_rad: {k:.4g}")
+    if spot:
+        print(f"# sideways slip fitted on the spot: mean r^2 / variance {spot[2]:.2f}; moving, "
+              f"what the skid leaves sideways has rms {spot[3]:.3g} m a step, the model "
+              f"{spot[4]:.3g} m")
 
     print(f"# command noise fitted to errors summed over {args.window} step(s)")
     print("# summed errors over windows of L steps: mean e^2 / model variance, distance and turn")
@@ -807,6 +911,9 @@ def main():
     print_bins("command v", steps, "dv", [0, 1e-9, 0.05, 0.15, 0.3, 10], nv)
     print_bins("command w", steps, "|w|", [0, 0.05, 0.3, 0.8, 1.5, 10], nw)
     print_bins("command w", steps, "dw", [0, 1e-9, 0.1, 0.3, 0.8, 10], nw)
+    if args.wheel_noise:  # each error against the other speed (the wheels' terms)
+        print_bins("command v", steps, "|w|", [0, 0.05, 0.3, 0.8, 1.5, 10], nv)
+        print_bins("command w", steps, "|v|", [0, 0.05, 0.15, 0.3, 0.5, 10], nw)
     spinning = [s for s in steps if s["on_the_spot"] and s["w"] != 0.0]
     if spinning:
         print(f"  on the spot, turning: {len(spinning)} steps, mean (e/sigma)^2 = "
@@ -826,7 +933,7 @@ def main():
 
     if args.json:
         values = {"steps": len(steps), "runs": len(runs),
-                  **ekf_values(gains, lag, command, odometry, c, k)}
+                  **ekf_values(gains, lag, command, odometry, c, k, args.lag_noise)}
         if turn_centre:
             values["turn_centre_offset_m_per_radps"] = turn_centre[0]
             values["turn_centre_offset_along_alone"] = turn_centre[1]
@@ -834,6 +941,9 @@ def main():
         if slip:
             values.update(zip(["lateral_slip_std_m_per_rad", "lateral_slip_std_m_per_rad_per_mps",
                                "lateral_slip_std_m_per_radps_change"], slip))
+        if spot:
+            values.update(slip_on_the_spot_ratio=spot[2], moving_sideways_rms_m=spot[3],
+                          moving_sideways_model_rms_m=spot[4])
         with open(args.json, "w") as f:
             json.dump(values, f, indent=2)
             f.write("\n")

@@ -1,12 +1,15 @@
 #!/usr/bin/python3
 """Test of scripts/calibrate_noise.py's command-following fit: it must recover the gains, the
 lag, the settling wheels' noise, the sideways slip by regime and the point beside the axle a
-robot turning on the spot turns about, of a robot made with known ones.
+robot turning on the spot turns about, of a robot made with known ones (case `regime`); the
+noise of wheels that vary each on its own (case `wheels`); the sideways slip on the spot of a
+robot whose sideways motion while moving has another form (case `spot`).
 
-    /usr/bin/python3 tests/integration/calibrate_noise_test.py SOURCE_DIR
+    /usr/bin/python3 tests/integration/calibrate_noise_test.py SOURCE_DIR [CASE] [OPTION ...]
 
-Three synthetic runs (seeds 1-3, 600 steps of 0.1 s each) of a unicycle whose axle centre moves
-at the commands through a first-order lag of tau = 0.05 s, times the gains 0.99 (speed) and 1.01
+(CASE `regime` when left out; OPTIONs are passed on to the script.) Three synthetic runs
+(seeds 1-3, 600 steps of 0.1 s each) of a unicycle whose axle centre moves at the commands
+through a first-order lag of tau = 0.05 s, times the gains 0.99 (speed) and 1.01
 (turn rate), plus white noise of 1 mm/s and 5 mrad/s and, in the period after each change of the
 command, 0.1 of that change (the settling wheels, slam.ekf.command_noise.settle_noise_fraction);
 the robot at rest before the first row; the point R 0.2 m ahead of the axle, as the script
@@ -17,18 +20,43 @@ stream), fitted with --slip-by-regime, and, when the command and the one before 
 axle turns about a point KS w beside it, so moves by KS (w n(th') - w_prev n(th)) (n the left
 normal; slam.ekf.turn_centre_offset_m_per_radps), fitted with --turn-centre. The speeds' noise
 also grows by LAG_NOISE times the gap between the command and the followed speed
-(slam.ekf.command_noise.lag_noise_fraction), fitted with --lag-noise. Asserted: the fitted command_lag_s within 0.005 s of 0.05, command_gain_v within 0.002
-of 0.99, command_gain_w within 0.005 of 1.01, settle_noise_fraction within 0.02 of 0.1, each
-slip and the turn centre's offset (fitted from both components together and from each alone:
-the shift at a change and the creep while held) within 20 % of its value, lag_noise_fraction
-within 0.1 of 0.3 (the gap right after a change is 0.135 of the change, so the fit shares it
-with the change term: 0.233 and 0.013 fitted on these runs). Shown by hand to fail: with the script's lag left at 0 (--no-lag)
-the gains are still found but the test fails on the lag; with the settle term left out of the
-script's sigmas it fails on it; with the change term left out of fit_slip_by_regime's variance
-it fails on the slips; with the turn centre's motion not taken out of the true steps
-(take_out_turn_centre) it fails on the change's slip, and with the creep (the along
-component) left out of fit_turn_centre on the offset along alone; without --lag-noise on the
-lag term (0 fitted).
+(slam.ekf.command_noise.lag_noise_fraction), fitted with --lag-noise.
+
+Case `regime` (--slip-by-regime --turn-centre --lag-noise). Asserted: the fitted command_lag_s
+within 0.005 s of 0.05, command_gain_v within 0.002 of 0.99, command_gain_w within 0.005 of
+1.01, settle_noise_fraction within 0.02 of 0.1, each slip and the turn centre's offset (fitted
+from both components together and from each alone: the shift at a change and the creep while
+held) within 20 % of its value, lag_noise_fraction within 0.1 of 0.3 (the gap right after a
+change is 0.135 of the change, so the fit shares it with the change term: 0.233 and 0.013 fitted
+on these runs); the wheels' terms not fitted. Shown by hand to fail: with the script's lag left
+at 0 (--no-lag) the gains are still found but the test fails on the lag; with the settle term
+left out of the script's sigmas it fails on it; with the change term left out of
+fit_slip_by_regime's variance it fails on the slips; with the turn centre's motion not taken out
+of the true steps (take_out_turn_centre) it fails on the change's slip, and with the creep (the
+along component) left out of fit_turn_centre on the offset along alone; without --lag-noise on
+the lag term (0 fitted).
+
+Case `wheels` (--slip-by-regime --turn-centre --wheel-noise; not --lag-noise: with the wheels'
+terms the fit gives the lag term's share to the change term, so the lag term is not asserted):
+the same robot, its speed's noise also growing by TURN_V = 0.005 m/rad times the turn rate
+followed and its turn rate's by SPEED_W = 0.02 rad/m times the speed followed
+(slam.ekf.command_noise.turn_v_noise_m_per_rad, speed_w_noise_rad_per_m). Asserted: all of
+case `regime` but the lag term; both wheels' terms within 20 % of their values and the floors
+(v_noise_std_mps, w_noise_std_radps) within 30 % of 1 mm/s and 5 mrad/s; and, fitted without
+--wheel-noise, w_noise_std_radps more than 30 % off (the runs test the terms: 0.0088 fitted).
+Bounds about three times the spread of ten draws of three runs (seeds 1-30): the terms
+0.0045-0.0054 and 0.018-0.021, the floors 0.00083-0.00116 and 0.0045-0.0053. Shown by hand
+to fail: with the terms left out of the script's sigmas (the floors 0.0031 and 0.0088), left
+unfitted (0), and with |w_f| and |v_f| swapped in them.
+
+Case `spot` (--slip-on-the-spot --turn-centre --lag-noise): the same robot with commands held
+5 steps and v = 0 three times in five, and moving (not on the spot) a white sideways noise of
+MOVING_SIDEWAYS = 50 micrometres a step in place of the slip, which is not per radian turned.
+Asserted: lateral_slip_std_m_per_rad and _per_radps_change within 20 % of K0 and KC (0.00019-
+0.00020 and 0.00044-0.00054 over ten draws, seeds 1-30), _per_rad_per_mps 0, the moving steps'
+printed rms within 10 % of MOVING_SIDEWAYS, and --slip-by-regime with --slip-on-the-spot an
+error (exit status 2 naming both). Shown by hand to fail: with the moving steps in the fit
+(k0 0.016), with the change term left out of the variance, and with the options not exclusive.
 
 Exit status 0 when the values are recovered, 1 with the reasons otherwise.
 """
@@ -53,10 +81,19 @@ K1 = 2e-3   # m/rad per m/s
 KC = 5e-4   # m per rad/s
 KS = 4e-3   # m per rad/s, on the spot
 LAG_NOISE = 0.3  # per m/s (rad/s) of the gap between the command and the followed speed
+TURN_V = 0.005   # m/s per rad/s (the wheels case)
+SPEED_W = 0.02   # rad/s per m/s (the wheels case)
+MOVING_SIDEWAYS = 5e-5  # m a step, moving (the spot case)
 
 
-def write_run(directory, seed):
-    """One run's trajectory.csv with the columns calibrate_noise.py reads."""
+def write_run(directory, seed, turn_v=0.0, speed_w=0.0, spot=False):
+    """One run's trajectory.csv with the columns calibrate_noise.py reads:
+    the robot of the module's docstring, its speed's noise growing by
+    `turn_v` times the turn rate followed and its turn rate's by `speed_w`
+    times the speed followed (the wheels' terms); with `spot`, commands
+    held 5 steps and v = 0 three times in five (many turns and changes on
+    the spot), and moving (not on the spot) the axle's sideways motion a
+    white noise of MOVING_SIDEWAYS a step instead of the slip."""
     rng = random.Random(seed)
     slip_rng = random.Random(seed + 1000)
     os.makedirs(directory)
@@ -72,8 +109,8 @@ def write_run(directory, seed):
                          "cmd_v", "cmd_w"])
         for k in range(600):
             # Row k: the pose at t_k and the command held over (t_k, t_k+1].
-            if k % 20 == 0:
-                v = rng.choice([0.0, 0.2, 0.4])
+            if k % (5 if spot else 20) == 0:
+                v = rng.choice([0.0, 0.0, 0.0, 0.2, 0.4] if spot else [0.0, 0.2, 0.4])
                 w = rng.uniform(-0.8, 0.8)
             rx, ry = x + OFFSET * math.cos(th), y + OFFSET * math.sin(th)
             odometry = [rx + rng.gauss(0, 1e-4), ry + rng.gauss(0, 1e-4), th + rng.gauss(0, 1e-4)]
@@ -81,12 +118,16 @@ def write_run(directory, seed):
             fv += beta * (v - fv)
             fw += beta * (w - fw)
             d = (GAIN_V * fv + rng.gauss(0, 0.001 + SETTLE * settle[0]
-                                         + LAG_NOISE * abs(v - fv))) * DT
+                                         + LAG_NOISE * abs(v - fv) + turn_v * abs(fw))) * DT
             dth = (GAIN_W * fw + rng.gauss(0, 0.005 + SETTLE * settle[1]
-                                           + LAG_NOISE * abs(w - fw))) * DT
-            lateral = slip_rng.gauss(0, math.sqrt((K0 ** 2 + (K1 * GAIN_V * fv) ** 2) * dth ** 2
-                                                  + (KC * abs(w - previous[1])) ** 2))
+                                           + LAG_NOISE * abs(w - fw) + speed_w * abs(fv))) * DT
             on_the_spot = v == 0.0 and previous[0] == 0.0
+            if spot and not on_the_spot:
+                lateral = slip_rng.gauss(0, MOVING_SIDEWAYS)
+            else:
+                lateral = slip_rng.gauss(0, math.sqrt((K0 ** 2 + (K1 * GAIN_V * fv) ** 2)
+                                                      * dth ** 2
+                                                      + (KC * abs(w - previous[1])) ** 2))
             w_prev = previous[1]
             settle = [abs(v - previous[0]), abs(w - previous[1])]
             previous = [v, w]
@@ -102,52 +143,139 @@ def write_run(directory, seed):
             th = math.remainder(th + dth, 2.0 * math.pi)
 
 
-def main(source_dir):
+def calibrate(source_dir, runs, options, fitted):
+    """The values calibrate_noise.py fits to `runs` with `options` (its --json
+    `fitted`), or None (its output printed) when it fails."""
+    result = subprocess.run(["/usr/bin/python3",
+                             os.path.join(source_dir, "scripts", "calibrate_noise.py"),
+                             *runs, "--offset", str(OFFSET), *options, "--json", fitted],
+                            capture_output=True, text=True)
+    if result.returncode != 0:
+        print(result.stdout + result.stderr)
+        return None
+    with open(fitted) as f:
+        return json.load(f)
+
+
+def value(values, key):
+    """A fitted value of slam.ekf (0 when not fitted)."""
+    return values.get(key, values["command_noise"].get(key, 0.0))
+
+
+def check_regime(values, lag_noise=True):
+    """The problems of the fit of the slip by regime, the turn centre, the
+    gains, the lag, the settle term and, with `lag_noise`, the lag term
+    (tolerances in the module's docstring)."""
+    print(f"fitted: command_lag_s {values['command_lag_s']:.4f} (made {TAU}), command_gain_v "
+          f"{values['command_gain_v']:.4f} ({GAIN_V}), command_gain_w "
+          f"{values['command_gain_w']:.4f} ({GAIN_W}), settle_noise_fraction "
+          f"{values['command_noise']['settle_noise_fraction']:.4f} ({SETTLE})")
+    print(f"fitted slips: {values['lateral_slip_std_m_per_rad']:.3g} ({K0}), "
+          f"{values['lateral_slip_std_m_per_rad_per_mps']:.3g} ({K1}), "
+          f"{values['lateral_slip_std_m_per_radps_change']:.3g} ({KC}), turn centre "
+          f"{values['turn_centre_offset_m_per_radps']:.3g} (along alone "
+          f"{values['turn_centre_offset_along_alone']:.3g}, across alone "
+          f"{values['turn_centre_offset_across_alone']:.3g}; {KS})")
+    problems = []
+    for key, made in (("lateral_slip_std_m_per_rad", K0),
+                      ("lateral_slip_std_m_per_rad_per_mps", K1),
+                      ("lateral_slip_std_m_per_radps_change", KC),
+                      ("turn_centre_offset_m_per_radps", KS),
+                      ("turn_centre_offset_along_alone", KS),
+                      ("turn_centre_offset_across_alone", KS)):
+        if abs(values[key] / made - 1.0) > 0.2:
+            problems.append(f"{key}: fitted {values[key]:.4g}, made {made} (tolerance 20 %)")
+    absolute = [("command_lag_s", TAU, 0.005), ("command_gain_v", GAIN_V, 0.002),
+                ("command_gain_w", GAIN_W, 0.005), ("settle_noise_fraction", SETTLE, 0.02)]
+    if lag_noise:
+        absolute.append(("lag_noise_fraction", LAG_NOISE, 0.1))
+    for key, made, tolerance in absolute:
+        fitted_value = value(values, key)
+        if abs(fitted_value - made) > tolerance:
+            problems.append(f"{key}: fitted {fitted_value:.5f}, made {made} (tolerance "
+                            f"{tolerance})")
+    return problems
+
+
+def check_relative(values, expected, tolerance):
+    """The problems of fitted values not within `tolerance` (a fraction) of
+    the (key, made) pairs `expected`."""
+    problems = []
+    for key, made in expected:
+        fitted_value = value(values, key)
+        print(f"fitted {key}: {fitted_value:.4g} (made {made})")
+        if abs(fitted_value / made - 1.0) > tolerance:
+            problems.append(f"{key}: fitted {fitted_value:.4g}, made {made} (tolerance "
+                            f"{tolerance:.0%})")
+    return problems
+
+
+REGIME = ["--slip-by-regime", "--turn-centre", "--lag-noise"]
+FLOORS = (("v_noise_std_mps", 0.001), ("w_noise_std_radps", 0.005))
+
+
+def main(source_dir, case, extra):
     out = tempfile.mkdtemp(prefix="calibrate_noise_test_")
     try:
+        robot = {"wheels": {"turn_v": TURN_V, "speed_w": SPEED_W},
+                 "spot": {"spot": True}}.get(case, {})
         runs = []
         for seed in (1, 2, 3):
             runs.append(os.path.join(out, f"run_{seed}"))
-            write_run(runs[-1], seed)
+            write_run(runs[-1], seed, **robot)
         fitted = os.path.join(out, "fit.json")
-        result = subprocess.run(["/usr/bin/python3",
-                                 os.path.join(source_dir, "scripts", "calibrate_noise.py"),
-                                 *runs, "--offset", str(OFFSET), "--slip-by-regime", "--turn-centre", "--lag-noise",
-                                 "--json", fitted]
-                                + sys.argv[2:], capture_output=True, text=True)
-        if result.returncode != 0:
-            print(result.stdout + result.stderr)
-            return 1
-        with open(fitted) as f:
-            values = json.load(f)
-        print(f"fitted: command_lag_s {values['command_lag_s']:.4f} (made {TAU}), command_gain_v "
-              f"{values['command_gain_v']:.4f} ({GAIN_V}), command_gain_w "
-              f"{values['command_gain_w']:.4f} ({GAIN_W}), settle_noise_fraction "
-              f"{values['command_noise']['settle_noise_fraction']:.4f} ({SETTLE})")
-        print(f"fitted slips: {values['lateral_slip_std_m_per_rad']:.3g} ({K0}), "
-              f"{values['lateral_slip_std_m_per_rad_per_mps']:.3g} ({K1}), "
-              f"{values['lateral_slip_std_m_per_radps_change']:.3g} ({KC}), turn centre "
-              f"{values['turn_centre_offset_m_per_radps']:.3g} (along alone "
-              f"{values['turn_centre_offset_along_alone']:.3g}, across alone "
-              f"{values['turn_centre_offset_across_alone']:.3g}; {KS})")
         problems = []
-        for key, made in (("lateral_slip_std_m_per_rad", K0),
-                          ("lateral_slip_std_m_per_rad_per_mps", K1),
-                          ("lateral_slip_std_m_per_radps_change", KC),
-                          ("turn_centre_offset_m_per_radps", KS),
-                          ("turn_centre_offset_along_alone", KS),
-                          ("turn_centre_offset_across_alone", KS)):
-            if abs(values[key] / made - 1.0) > 0.2:
-                problems.append(f"{key}: fitted {values[key]:.4g}, made {made} (tolerance 20 %)")
-        for key, made, tolerance in (("command_lag_s", TAU, 0.005),
-                                     ("command_gain_v", GAIN_V, 0.002),
-                                     ("command_gain_w", GAIN_W, 0.005),
-                                     ("settle_noise_fraction", SETTLE, 0.02),
-                                     ("lag_noise_fraction", LAG_NOISE, 0.1)):
-            fitted_value = values.get(key, values["command_noise"].get(key, 0.0))
-            if abs(fitted_value - made) > tolerance:
-                problems.append(f"{key}: fitted {fitted_value:.5f}, made {made} (tolerance "
-                                f"{tolerance})")
+        if case == "regime":
+            values = calibrate(source_dir, runs, REGIME + extra, fitted)
+            if values is None:
+                return 1
+            problems += check_regime(values)
+            for key in ("turn_v_noise_m_per_rad", "speed_w_noise_rad_per_m"):
+                if key in values["command_noise"]:
+                    problems.append(f"{key} fitted without --wheel-noise")
+        elif case == "wheels":
+            options = ["--slip-by-regime", "--turn-centre"]
+            values = calibrate(source_dir, runs, options + ["--wheel-noise"] + extra, fitted)
+            if values is None:
+                return 1
+            problems += check_regime(values, lag_noise=False)
+            problems += check_relative(values, (("turn_v_noise_m_per_rad", TURN_V),
+                                                ("speed_w_noise_rad_per_m", SPEED_W)), 0.2)
+            problems += check_relative(values, FLOORS, 0.3)
+            # The same runs without the wheels' terms: the floors take their
+            # noise (the runs do test the terms).
+            without = calibrate(source_dir, runs, options, fitted)
+            if without is None:
+                return 1
+            print("without --wheel-noise:")
+            if not check_relative(without, FLOORS[1:], 0.3):
+                problems.append("without --wheel-noise w_noise_std_radps is still within 30 % "
+                                "of the floor made: the runs do not test the wheels' terms")
+        elif case == "spot":
+            values = calibrate(source_dir, runs,
+                               ["--slip-on-the-spot", "--turn-centre", "--lag-noise"] + extra,
+                               fitted)
+            if values is None:
+                return 1
+            problems += check_relative(values, (("lateral_slip_std_m_per_rad", K0),
+                                                ("lateral_slip_std_m_per_radps_change", KC)),
+                                       0.2)
+            problems += check_relative(values, (("moving_sideways_rms_m", MOVING_SIDEWAYS),),
+                                       0.1)
+            if values["lateral_slip_std_m_per_rad_per_mps"] != 0.0:
+                problems.append("lateral_slip_std_m_per_rad_per_mps: fitted "
+                                f"{values['lateral_slip_std_m_per_rad_per_mps']}, expected 0")
+            both = subprocess.run(["/usr/bin/python3",
+                                   os.path.join(source_dir, "scripts", "calibrate_noise.py"),
+                                   *runs, "--slip-on-the-spot", "--slip-by-regime"],
+                                  capture_output=True, text=True)
+            if (both.returncode != 2 or "--slip-on-the-spot" not in both.stderr
+                    or "--slip-by-regime" not in both.stderr):
+                problems.append("--slip-on-the-spot with --slip-by-regime: expected exit status "
+                                f"2 naming both, got {both.returncode}: {both.stderr}")
+        else:
+            print(f"unknown case {case!r}: expected regime, wheels or spot")
+            return 2
         for problem in problems:
             print(problem)
         return 1 if problems else 0
@@ -156,4 +284,6 @@ def main(source_dir):
 
 
 if __name__ == "__main__":
-    sys.exit(main(sys.argv[1]))
+    arguments = sys.argv[2:]
+    case = arguments.pop(0) if arguments and not arguments[0].startswith("-") else "regime"
+    sys.exit(main(sys.argv[1], case, arguments))
