@@ -225,9 +225,12 @@ def nelder_mead(f, x0, step=0.5, iterations=3000, tolerance=1e-10):
 
 def fit(negative_log_likelihood, initial):
     """The non-negative parameters that minimise the negative log-likelihood,
-    searched over their logarithms."""
+    searched over their logarithms. A parameter the data do not need can
+    come out as 0 (its logarithm run off to where exp underflows); started
+    again from there (the gains' rounds), it starts at the smallest positive
+    double instead."""
     best = nelder_mead(lambda logs: negative_log_likelihood([math.exp(l) for l in logs]),
-                       [math.log(x) for x in initial])
+                       [math.log(max(x, sys.float_info.min)) for x in initial])
     return [math.exp(l) for l in best]
 
 

@@ -58,9 +58,15 @@ printed rms within 10 % of MOVING_SIDEWAYS, and --slip-by-regime with --slip-on-
 error (exit status 2 naming both). Shown by hand to fail: with the moving steps in the fit
 (k0 0.016), with the change term left out of the variance, and with the options not exclusive.
 
+Case `straight` (--wheel-noise on runs whose turn-rate command is always 0): the fit ends with
+the speed's lag and gain (within 0.005 s and 0.002), and the script's fit() started from a term
+at exactly 0 (an earlier round's underflow) finds the rest; it raised "math domain error" before
+fit() started from the smallest positive double.
+
 Exit status 0 when the values are recovered, 1 with the reasons otherwise.
 """
 import csv
+import importlib.util
 import json
 import math
 import os
@@ -86,14 +92,15 @@ SPEED_W = 0.02   # rad/s per m/s (the wheels case)
 MOVING_SIDEWAYS = 5e-5  # m a step, moving (the spot case)
 
 
-def write_run(directory, seed, turn_v=0.0, speed_w=0.0, spot=False):
+def write_run(directory, seed, turn_v=0.0, speed_w=0.0, spot=False, straight=False):
     """One run's trajectory.csv with the columns calibrate_noise.py reads:
     the robot of the module's docstring, its speed's noise growing by
     `turn_v` times the turn rate followed and its turn rate's by `speed_w`
     times the speed followed (the wheels' terms); with `spot`, commands
     held 5 steps and v = 0 three times in five (many turns and changes on
     the spot), and moving (not on the spot) the axle's sideways motion a
-    white noise of MOVING_SIDEWAYS a step instead of the slip."""
+    white noise of MOVING_SIDEWAYS a step instead of the slip; with
+    `straight`, every turn-rate command 0."""
     rng = random.Random(seed)
     slip_rng = random.Random(seed + 1000)
     os.makedirs(directory)
@@ -111,7 +118,7 @@ def write_run(directory, seed, turn_v=0.0, speed_w=0.0, spot=False):
             # Row k: the pose at t_k and the command held over (t_k, t_k+1].
             if k % (5 if spot else 20) == 0:
                 v = rng.choice([0.0, 0.0, 0.0, 0.2, 0.4] if spot else [0.0, 0.2, 0.4])
-                w = rng.uniform(-0.8, 0.8)
+                w = 0.0 if straight else rng.uniform(-0.8, 0.8)
             rx, ry = x + OFFSET * math.cos(th), y + OFFSET * math.sin(th)
             odometry = [rx + rng.gauss(0, 1e-4), ry + rng.gauss(0, 1e-4), th + rng.gauss(0, 1e-4)]
             writer.writerow([f"{k * DT:.3f}", rx, ry, th, *odometry, v, w])
@@ -218,7 +225,8 @@ def main(source_dir, case, extra):
     out = tempfile.mkdtemp(prefix="calibrate_noise_test_")
     try:
         robot = {"wheels": {"turn_v": TURN_V, "speed_w": SPEED_W},
-                 "spot": {"spot": True}}.get(case, {})
+                 "spot": {"spot": True},
+                 "straight": {"turn_v": TURN_V, "speed_w": SPEED_W, "straight": True}}.get(case, {})
         runs = []
         for seed in (1, 2, 3):
             runs.append(os.path.join(out, f"run_{seed}"))
@@ -273,8 +281,31 @@ def main(source_dir, case, extra):
                     or "--slip-by-regime" not in both.stderr):
                 problems.append("--slip-on-the-spot with --slip-by-regime: expected exit status "
                                 f"2 naming both, got {both.returncode}: {both.stderr}")
+        elif case == "straight":
+            # Runs that never turn leave the turn-rate terms nothing to fit:
+            # they run off to 0, and the fit must still end with the gain and
+            # the lag of the speed.
+            values = calibrate(source_dir, runs, ["--wheel-noise"] + extra, fitted)
+            if values is None:
+                return 1
+            if abs(values["command_lag_s"] - TAU) > 0.005:
+                problems.append(f"command_lag_s: fitted {values['command_lag_s']}, made {TAU}")
+            if abs(values["command_gain_v"] - GAIN_V) > 0.002:
+                problems.append(f"command_gain_v: fitted {values['command_gain_v']}, made {GAIN_V}")
+            # A round of the fit started where an earlier one left a term at
+            # exactly 0 (exp underflowed; seen on the tour's straight runs).
+            spec = importlib.util.spec_from_file_location(
+                "calibrate_noise", os.path.join(source_dir, "scripts", "calibrate_noise.py"))
+            script = importlib.util.module_from_spec(spec)
+            spec.loader.exec_module(script)
+            try:
+                best = script.fit(lambda q: (q[1] - 2.0) ** 2, [0.0, 1.0])
+                if abs(best[1] - 2.0) > 1e-3:
+                    problems.append(f"fit from a zero term: {best}, expected [.., 2]")
+            except ValueError as e:
+                problems.append(f"fit from a zero term raised {e!r}")
         else:
-            print(f"unknown case {case!r}: expected regime, wheels or spot")
+            print(f"unknown case {case!r}: expected regime, wheels, spot or straight")
             return 2
         for problem in problems:
             print(problem)
