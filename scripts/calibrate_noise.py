@@ -4,7 +4,8 @@ values of slam.ekf.command_gain_v, _w, slam.ekf.command_noise.*, slam.ekf.odomet
 slam.ekf.lateral_skid_s, slam.ekf.lateral_slip_std_m_per_rad (and by regime) and
 slam.ekf.turn_centre_offset_m_per_radps (docs/method.md, "Calibrating the process noise").
 
-    scripts/calibrate_noise.py DIR [DIR ...] [--offset A] [--window L] [--no-gain] [--no-lag]
+    scripts/calibrate_noise.py DIR [DIR ...] [--offset A] [--window L] [--no-gain]
+                               [--no-lag | --drive-lag]
                                [--slip-by-regime | --slip-on-the-spot] [--turn-centre]
                                [--lag-noise] [--wheel-noise] [--json FILE]
     scripts/calibrate_noise.py --consistency WORK --write CONFIG [--config BASE] [--seed S]
@@ -23,7 +24,12 @@ an arc along the mid-arc heading, plus a sideways skid):
   the time constant tau; FollowCommand in slam/motion_model.h: the speeds
   followed move toward the command by 1 - exp(-dt / tau) a step, from rest
   at the start; tau fitted first, by the least squared speed errors, with
-  the gains by least squares at each tau; --no-lag keeps tau 0) and scaled
+  the gains by least squares at each tau; --no-lag keeps tau 0; --drive-lag
+  fits the speed's lag with its change a step limited to a m/s^2 and the
+  turn rate's own lag, slam.ekf.command_lag_s, command_max_accel_mps2 and
+  command_lag_w_s (departure 27), each DIR weighted alike: the cost is the
+  sum over the DIRs of log(mean e^2), so give one DIR per way of driving;
+  fit_drive_lag) and scaled
   by the gains g_v and g_w (slam.ekf.command_gain_v, _w: the
   robot's mean speed over its command), its noise growing with the change
   from the command of row k-2 and with the change one row earlier (row k-2
@@ -269,51 +275,114 @@ def command_errors(s, gains=(1.0, 1.0)):
     return (s["d"] / s["dt"] - gains[0] * s["fv"], s["dth"] / s["dt"] - gains[1] * s["fw"])
 
 
-def apply_lag(runs_steps, lag):
+def follow(followed, command, dt, lag, max_accel=0.0):
+    """One component of slam::FollowCommand: `followed` moved toward `command`
+    through a first-order lag of time constant `lag` (0: the command), its
+    change then held within +-max_accel dt when `max_accel` > 0."""
+    target = command if lag <= 0.0 else followed - math.expm1(-dt / lag) * (command - followed)
+    if max_accel > 0.0:
+        most = max_accel * dt
+        target = followed + min(most, max(-most, target - followed))
+    return target
+
+
+def apply_lag(runs_steps, lag, lag_w=None, max_accel=0.0):
     """Sets each step's followed speeds (fv, fw): the commands through a
-    first-order lag of time constant `lag` seconds, from rest at a run's
-    first step, as slam::FollowCommand (lag 0: the commands)."""
+    first-order lag of time constant `lag` seconds (the turn rate's `lag_w`,
+    None: the same), the speed's change limited to `max_accel` m/s^2 a
+    second (0: no limit), from rest at a run's first step, as
+    slam::FollowCommand."""
+    lag_w = lag if lag_w is None else lag_w
     for steps in runs_steps:
         fv = fw = 0.0
         for s in steps:
-            beta = 1.0 if lag <= 0.0 else -math.expm1(-s["dt"] / lag)
-            fv += beta * (s["v"] - fv)
-            fw += beta * (s["w"] - fw)
+            fv = follow(fv, s["v"], s["dt"], lag, max_accel)
+            fw = follow(fw, s["w"], s["dt"], lag_w)
             s["fv"], s["fw"] = fv, fw
+
+
+def speed_cost(groups, speed, followed):
+    """sum over the groups of log(mean e^2) of one speed ("d" with "fv", or
+    "dth" with "fw"), the gain by least squares over all the groups' steps:
+    the Gaussian likelihood's cost with constant variances, each group
+    weighted alike whatever its number of steps."""
+    steps = [s for runs_steps in groups for run_steps in runs_steps for s in run_steps]
+    sxx = sum(s[followed] ** 2 for s in steps)
+    gain = sum(s[followed] * s[speed] / s["dt"] for s in steps) / sxx if sxx > 0 else 1.0
+    cost = 0.0
+    for runs_steps in groups:
+        group = [s for run_steps in runs_steps for s in run_steps]
+        mse = sum((s[speed] / s["dt"] - gain * s[followed]) ** 2 for s in group) / len(group)
+        cost += math.log(max(mse, 1e-300))
+    return cost
 
 
 def lag_cost(runs_steps, lag):
     """log(mean e_v^2) + log(mean e_w^2) with the lag and the least-squares
     gains: the Gaussian likelihood's cost with constant variances."""
     apply_lag(runs_steps, lag)
-    steps = [s for run_steps in runs_steps for s in run_steps]
-    cost = 0.0
-    for speed, followed in (("d", "fv"), ("dth", "fw")):
-        sxx = sum(s[followed] ** 2 for s in steps)
-        gain = sum(s[followed] * s[speed] / s["dt"] for s in steps) / sxx if sxx > 0 else 1.0
-        mse = sum((s[speed] / s["dt"] - gain * s[followed]) ** 2 for s in steps) / len(steps)
-        cost += math.log(max(mse, 1e-300))
-    return cost
+    return speed_cost([runs_steps], "d", "fv") + speed_cost([runs_steps], "dth", "fw")
+
+
+def golden_section(cost, lo, hi, tolerance):
+    """The argument in [lo, hi] that minimises `cost` (unimodal there)."""
+    ratio = (math.sqrt(5.0) - 1.0) / 2.0
+    a, b = hi - ratio * (hi - lo), lo + ratio * (hi - lo)
+    fa, fb = cost(a), cost(b)
+    while hi - lo > tolerance:
+        if fa < fb:
+            hi, b, fb = b, a, fa
+            a = hi - ratio * (hi - lo)
+            fa = cost(a)
+        else:
+            lo, a, fa = a, b, fb
+            b = lo + ratio * (hi - lo)
+            fb = cost(b)
+    return 0.5 * (lo + hi)
 
 
 def fit_lag(runs_steps, longest=0.5):
     """The lag time constant in [0, longest] s that minimises lag_cost
     (golden-section search; 0 if no lag fits better)."""
-    lo, hi = 0.0, longest
-    ratio = (math.sqrt(5.0) - 1.0) / 2.0
-    a, b = hi - ratio * (hi - lo), lo + ratio * (hi - lo)
-    fa, fb = lag_cost(runs_steps, a), lag_cost(runs_steps, b)
-    while hi - lo > 1e-4:
-        if fa < fb:
-            hi, b, fb = b, a, fa
-            a = hi - ratio * (hi - lo)
-            fa = lag_cost(runs_steps, a)
-        else:
-            lo, a, fa = a, b, fb
-            b = lo + ratio * (hi - lo)
-            fb = lag_cost(runs_steps, b)
-    best = 0.5 * (lo + hi)
+    best = golden_section(lambda lag: lag_cost(runs_steps, lag), 0.0, longest, 1e-4)
     return best if lag_cost(runs_steps, best) < lag_cost(runs_steps, 0.0) else 0.0
+
+
+def fit_drive_lag(groups, longest=0.5):
+    """(lag_v, lag_w, max_accel): the speed's lag with its acceleration limit
+    and the turn rate's own lag (departure 27), each group of runs (one
+    DIR: one way of driving) weighted alike (speed_cost). The turn rate's lag
+    by golden-section search over [0, longest] s. The speed's cost is flat
+    in the limit above the largest change the commands ask for and steep
+    below it, so the lag and limit are searched on a grid: the lag in steps
+    of 5 ms up to 0.1 s, the limit from 0.2 to 5 m/s^2 in steps of 5 % and
+    none (0), then around the best on a grid five times finer. Each lag 0
+    where no lag fits better."""
+    def cost_w(lag_w):
+        for runs_steps in groups:
+            apply_lag(runs_steps, 0.0, lag_w)
+        return speed_cost(groups, "dth", "fw")
+
+    lag_w = golden_section(cost_w, 0.0, longest, 1e-4)
+    if cost_w(lag_w) >= cost_w(0.0):
+        lag_w = 0.0
+
+    def cost_v(lag_v, max_accel):
+        for runs_steps in groups:
+            apply_lag(runs_steps, lag_v, 0.0, max_accel)
+        return speed_cost(groups, "d", "fv")
+
+    def search(lags, limits):
+        return min((cost_v(t, a), t, a) for t in lags for a in limits)
+
+    limits = [0.2 * 1.05 ** i for i in range(int(math.log(25.0) / math.log(1.05)) + 1)]
+    _, lag_v, max_accel = search([0.005 * i for i in range(21)], [0.0] + limits)
+    fine_lags = [max(0.0, lag_v + 0.001 * i) for i in range(-5, 6)]
+    fine_limits = [0.0] if max_accel == 0.0 else [max_accel * 1.01 ** i for i in range(-5, 6)]
+    _, lag_v, max_accel = search(fine_lags, fine_limits)
+    for runs_steps in groups:
+        apply_lag(runs_steps, lag_v, lag_w, max_accel)
+    return lag_v, lag_w, max_accel
 
 
 def fit_gains(steps, p):
@@ -761,8 +830,13 @@ def main():
                              "many steps (default 1: each step on its own)")
     parser.add_argument("--no-gain", action="store_true",
                         help="keep the command gains at 1 (fit the noise only)")
-    parser.add_argument("--no-lag", action="store_true",
-                        help="no lag of the wheels behind the command (command_lag_s 0)")
+    lag_model = parser.add_mutually_exclusive_group()
+    lag_model.add_argument("--no-lag", action="store_true",
+                     help="no lag of the wheels behind the command (command_lag_s 0)")
+    lag_model.add_argument("--drive-lag", action="store_true",
+                     help="the speed's lag with its acceleration limit and the turn rate's own "
+                          "lag (command_lag_s, command_max_accel_mps2, command_lag_w_s; "
+                          "departure 27), each DIR weighted alike: one DIR per way of driving")
     slip = parser.add_mutually_exclusive_group()
     slip.add_argument("--slip-by-regime", action="store_true",
                       help="fit the sideways slip per radian turned on the spot, its growth "
@@ -830,8 +904,18 @@ def main():
         print(f"calibrate_noise: --window: expected an integer >= 1 (got {args.window})",
               file=sys.stderr)
         return 2
-    lag = 0.0 if args.no_lag else fit_lag(runs_steps)
-    apply_lag(runs_steps, lag)
+    drive = None  # (lag_w, max_accel) with --drive-lag
+    if args.drive_lag:
+        groups, start = [], 0
+        for path in args.dirs:  # one group per DIR, in run_dirs' order
+            count = len(run_dirs([path]))
+            groups.append(runs_steps[start:start + count])
+            start += count
+        lag, lag_w, max_accel = fit_drive_lag(groups)
+        drive = (lag_w, max_accel)
+    else:
+        lag = 0.0 if args.no_lag else fit_lag(runs_steps)
+        apply_lag(runs_steps, lag)
     # The odometry against the true steps as they are (the turn centre is a
     # model of the command input only).
     odometry = fit_odometry(steps)
@@ -852,6 +936,9 @@ def main():
     print(f"    command_gain_v: {gains[0]:.6g}   # standard error {gains[2]:.2g}")
     print(f"    command_gain_w: {gains[1]:.6g}   # standard error {gains[3]:.2g}")
     print(f"    command_lag_s: {lag:.4g}")
+    if drive:
+        print(f"    command_lag_w_s: {drive[0]:.4g}")
+        print(f"    command_max_accel_mps2: {drive[1]:.4g}")
     print("    command_noise:")
     for name, value in command_noise(command, args.lag_noise).items():
         print(f"      {name}: {value:.4g}")
@@ -937,6 +1024,8 @@ def main():
     if args.json:
         values = {"steps": len(steps), "runs": len(runs),
                   **ekf_values(gains, lag, command, odometry, c, k, args.lag_noise)}
+        if drive:
+            values.update(command_lag_w_s=drive[0], command_max_accel_mps2=drive[1])
         if turn_centre:
             values["turn_centre_offset_m_per_radps"] = turn_centre[0]
             values["turn_centre_offset_along_alone"] = turn_centre[1]

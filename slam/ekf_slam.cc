@@ -218,7 +218,7 @@ MotionInput EkfSlam::CheckedMotionInput(const SensorRecord& record) const {
     RequireFinite(record.command.v_mps, "record.command.v_mps");
     RequireFinite(record.command.w_radps, "record.command.w_radps");
     const Twist2 followed =
-        FollowCommand(followed_command_, record.command, record.dt_s, params_.command_lag_s);
+        FollowCommand(followed_command_, record.command, record.dt_s, params_.Following());
     input = CommandInput(record.command, record.dt_s, params_.command_noise, previous_command_,
                          params_.command_gain_v, params_.command_gain_w, &followed,
                          previous_change_);
@@ -252,7 +252,7 @@ void EkfSlam::Predict(const SensorRecord& record, const MotionInput& input) {
     has_odometry_ = true;
   }
   followed_command_ =
-      FollowCommand(followed_command_, record.command, record.dt_s, params_.command_lag_s);
+      FollowCommand(followed_command_, record.command, record.dt_s, params_.Following());
   previous_change_ = Twist2{record.command.v_mps - previous_command_.v_mps,
                             record.command.w_radps - previous_command_.w_radps};
   previous_command_ = record.command;

@@ -1,5 +1,6 @@
 #include "slam/motion_model.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "common/angles.h"
@@ -125,11 +126,25 @@ Eigen::Vector3d PredictPose(const Eigen::Vector3d& pose_WR, const Eigen::Vector2
   return ApplyStep(pose_WR, dth, step, A, W);
 }
 
-Twist2 FollowCommand(const Twist2& followed, const Twist2& command, double dt_s, double lag_s) {
-  if (lag_s <= 0.0) return command;
+namespace {
+
+// One component of FollowCommand: the lag's step toward `target`.
+double FollowThroughLag(double followed, double target, double dt_s, double lag_s) {
+  if (lag_s <= 0.0) return target;
   const double beta = -std::expm1(-dt_s / lag_s);  // 1 - exp(-dt / lag), exact for small dt
-  return Twist2{followed.v_mps + beta * (command.v_mps - followed.v_mps),
-                followed.w_radps + beta * (command.w_radps - followed.w_radps)};
+  return followed + beta * (target - followed);
+}
+
+}  // namespace
+
+Twist2 FollowCommand(const Twist2& followed, const Twist2& command, double dt_s,
+                     const CommandFollowing& following) {
+  double v = FollowThroughLag(followed.v_mps, command.v_mps, dt_s, following.lag_v_s);
+  if (following.max_accel_mps2 > 0.0) {
+    const double most = following.max_accel_mps2 * dt_s;
+    v = followed.v_mps + std::clamp(v - followed.v_mps, -most, most);
+  }
+  return Twist2{v, FollowThroughLag(followed.w_radps, command.w_radps, dt_s, following.lag_w_s)};
 }
 
 MotionInput CommandInput(const Twist2& command, double dt_s, const CommandNoiseParams& noise,

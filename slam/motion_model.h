@@ -66,12 +66,15 @@ Eigen::Vector3d PredictPose(const Eigen::Vector3d& pose_WR, const Eigen::Vector2
                             const TurnCentre& turn_centre = TurnCentre());
 
 /// The speeds the robot moves at over a step of `dt_s` (>= 0) when it
-/// follows `command` through a first-order lag of time constant `lag_s`
-/// (>= 0), having moved at `followed` over the step before:
-///   followed + (1 - exp(-dt / lag)) (command - followed),
-/// both components (the wheels' lag acts on v and w alike). `lag_s` = 0:
-/// the command itself (EkfParams::command_lag_s).
-Twist2 FollowCommand(const Twist2& followed, const Twist2& command, double dt_s, double lag_s);
+/// follows `command` as `following` says (CommandFollowing), having moved at `followed` over the step before: each
+/// component through a first-order lag of its own time constant tau,
+///   followed + (1 - exp(-dt / tau)) (command - followed)
+/// (tau = 0: the command itself), the speed's change over the step then
+/// held within +-max_accel dt when a limit is set (the drive's torque
+/// limit: a large step of the command is followed at a bounded
+/// acceleration, a small one through the lag).
+Twist2 FollowCommand(const Twist2& followed, const Twist2& command, double dt_s,
+                     const CommandFollowing& following);
 
 /// The command held over `dt_s` (>= 0) as an input: increment (g_v v dt,
 /// g_w w dt) of the speeds (v, w) the robot moves at, `*followed` when not

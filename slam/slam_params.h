@@ -172,6 +172,14 @@ struct OdometryNoiseParams {
   void ValidateOrThrow() const { ThrowIfProblems(Validate()); }
 };
 
+/// How the wheels follow the command (EkfParams::command_lag_s,
+/// command_lag_w_s, command_max_accel_mps2; departures 21 and 27).
+struct CommandFollowing {
+  double lag_v_s = 0.0;         ///< the speed's lag time constant, s (>= 0; 0: none)
+  double lag_w_s = 0.0;         ///< the turn rate's, s (>= 0; 0: none)
+  double max_accel_mps2 = 0.0;  ///< the speed's largest change per second (> 0), 0: no limit
+};
+
 /// Parameters of the EKF-SLAM filters (slam/README.md, "The filter").
 /// Serialized under `slam.ekf.*`.
 struct EkfParams {
@@ -201,6 +209,22 @@ struct EkfParams {
   /// command held. Identified by scripts/calibrate_noise.py. 0: the command
   /// held over the step (the paper's).
   double command_lag_s = 0.0;
+  /// The turn rate's own lag time constant, seconds (>= 0), when the wheels
+  /// follow a change of the turn rate otherwise than one of the speed
+  /// (departure 27); negative (the default): command_lag_s, the one lag of
+  /// both. Identified by scripts/calibrate_noise.py --drive-lag.
+  double command_lag_w_s = -1.0;
+  /// The speed's largest change per second the prediction follows, m/s^2
+  /// (> 0), on top of the lag: a large step of the command is followed at
+  /// this bounded acceleration (the drive's torque limit), a small one
+  /// through the lag (departure 27). 0 (the default): no limit.
+  /// Identified by scripts/calibrate_noise.py --drive-lag.
+  double command_max_accel_mps2 = 0.0;
+  /// The three above as FollowCommand takes them.
+  CommandFollowing Following() const {
+    return CommandFollowing{command_lag_s, command_lag_w_s < 0.0 ? command_lag_s : command_lag_w_s,
+                            command_max_accel_mps2};
+  }
   /// Input noise when `input` is "command".
   CommandNoiseParams command_noise;
   /// Input noise when `input` is "odometry".
@@ -335,6 +359,8 @@ struct EkfParams {
     a->Visit(MJSLAM_NVP(command_gain_v));
     a->Visit(MJSLAM_NVP(command_gain_w));
     a->Visit(MJSLAM_NVP(command_lag_s));
+    a->Visit(MJSLAM_NVP(command_lag_w_s));
+    a->Visit(MJSLAM_NVP(command_max_accel_mps2));
     a->Visit(MJSLAM_NVP(command_noise));
     a->Visit(MJSLAM_NVP(odometry_noise));
     a->Visit(MJSLAM_NVP(lateral_slip_std_m_per_rad));

@@ -63,6 +63,13 @@ the speed's lag and gain (within 0.005 s and 0.002), and the script's fit() star
 at exactly 0 (an earlier round's underflow) finds the rest; it raised "math domain error" before
 fit() started from the smallest positive double.
 
+Case `drive` (--drive-lag, two DIRs): the robot's speed follows through a lag of 0.03 s whose
+change a step is limited to 0.8 m/s^2 (slam.ekf.command_max_accel_mps2), its turn rate through
+a lag of 0.07 s (command_lag_w_s); three runs of the steps above in one sweep directory and three
+of a ramp (0.05 m/s a row up to 0.4 m/s and down, no turn) in another. Asserted: the lags within
+0.005 s and the limit within 0.08 m/s^2 of their values; and, fitted without --drive-lag, the
+one lag more than 0.005 s off the speed's (the runs test the model).
+
 Exit status 0 when the values are recovered, 1 with the reasons otherwise.
 """
 import csv
@@ -90,9 +97,11 @@ LAG_NOISE = 0.3  # per m/s (rad/s) of the gap between the command and the follow
 TURN_V = 0.005   # m/s per rad/s (the wheels case)
 SPEED_W = 0.02   # rad/s per m/s (the wheels case)
 MOVING_SIDEWAYS = 5e-5  # m a step, moving (the spot case)
+DRIVE = {"tau": 0.03, "tau_w": 0.07, "max_accel": 0.8}  # the drive case (departure 27)
 
 
-def write_run(directory, seed, turn_v=0.0, speed_w=0.0, spot=False, straight=False):
+def write_run(directory, seed, turn_v=0.0, speed_w=0.0, spot=False, straight=False, tau=TAU,
+              tau_w=TAU, max_accel=0.0, ramp=False):
     """One run's trajectory.csv with the columns calibrate_noise.py reads:
     the robot of the module's docstring, its speed's noise growing by
     `turn_v` times the turn rate followed and its turn rate's by `speed_w`
@@ -100,7 +109,12 @@ def write_run(directory, seed, turn_v=0.0, speed_w=0.0, spot=False, straight=Fal
     held 5 steps and v = 0 three times in five (many turns and changes on
     the spot), and moving (not on the spot) the axle's sideways motion a
     white noise of MOVING_SIDEWAYS a step instead of the slip; with
-    `straight`, every turn-rate command 0."""
+    `straight`, every turn-rate command 0. The speed follows through a lag of
+    `tau`, its change a step then held within +-max_accel DT (0: no limit),
+    the turn rate through a lag of `tau_w`; with `ramp` the speed command
+    climbs from rest to 0.4 m/s in steps of 0.05 m/s a row, holds for 30
+    rows and comes down likewise, the turn rate 0 (the tour's way of
+    driving)."""
     rng = random.Random(seed)
     slip_rng = random.Random(seed + 1000)
     os.makedirs(directory)
@@ -109,21 +123,29 @@ def write_run(directory, seed, turn_v=0.0, speed_w=0.0, spot=False, straight=Fal
     v = w = 0.0
     previous = [0.0, 0.0]  # the command of the row before (at rest before the first)
     settle = [0.0, 0.0]    # |change| of the command at the row before
-    beta = 1.0 - math.exp(-DT / TAU)
+    beta = 1.0 - math.exp(-DT / tau)
+    beta_w = 1.0 - math.exp(-DT / tau_w)
     with open(os.path.join(directory, "trajectory.csv"), "w", newline="") as f:
         writer = csv.writer(f)
         writer.writerow(["t", "true_x", "true_y", "true_th", "odom_x", "odom_y", "odom_th",
                          "cmd_v", "cmd_w"])
         for k in range(600):
             # Row k: the pose at t_k and the command held over (t_k, t_k+1].
-            if k % (5 if spot else 20) == 0:
+            if ramp:  # 8 rows up, 30 held, 8 down, 4 at rest: 50 rows a cycle
+                phase = k % 50
+                v = 0.05 * min(phase + 1, 8, max(0, 46 - phase))
+                w = 0.0
+            elif k % (5 if spot else 20) == 0:
                 v = rng.choice([0.0, 0.0, 0.0, 0.2, 0.4] if spot else [0.0, 0.2, 0.4])
                 w = 0.0 if straight else rng.uniform(-0.8, 0.8)
             rx, ry = x + OFFSET * math.cos(th), y + OFFSET * math.sin(th)
             odometry = [rx + rng.gauss(0, 1e-4), ry + rng.gauss(0, 1e-4), th + rng.gauss(0, 1e-4)]
             writer.writerow([f"{k * DT:.3f}", rx, ry, th, *odometry, v, w])
-            fv += beta * (v - fv)
-            fw += beta * (w - fw)
+            change = beta * (v - fv)
+            if max_accel > 0.0:
+                change = max(-max_accel * DT, min(max_accel * DT, change))
+            fv += change
+            fw += beta_w * (w - fw)
             d = (GAIN_V * fv + rng.gauss(0, 0.001 + SETTLE * settle[0]
                                          + LAG_NOISE * abs(v - fv) + turn_v * abs(fw))) * DT
             dth = (GAIN_W * fw + rng.gauss(0, 0.005 + SETTLE * settle[1]
@@ -225,6 +247,7 @@ def main(source_dir, case, extra):
     out = tempfile.mkdtemp(prefix="calibrate_noise_test_")
     try:
         robot = {"wheels": {"turn_v": TURN_V, "speed_w": SPEED_W},
+                 "drive": DRIVE,
                  "spot": {"spot": True},
                  "straight": {"turn_v": TURN_V, "speed_w": SPEED_W, "straight": True}}.get(case, {})
         runs = []
@@ -304,8 +327,39 @@ def main(source_dir, case, extra):
                     problems.append(f"fit from a zero term: {best}, expected [.., 2]")
             except ValueError as e:
                 problems.append(f"fit from a zero term raised {e!r}")
+        elif case == "drive":
+            # Two ways of driving, one DIR each: the steps of the other cases
+            # and the ramp, of a drive whose speed is rate-limited and whose
+            # turn rate has its own lag.
+            ramps = []
+            for seed in (4, 5, 6):
+                ramps.append(os.path.join(out, f"ramp_{seed}"))
+                write_run(ramps[-1], seed, **DRIVE, ramp=True)
+            steps_dir, ramps_dir = os.path.join(out, "steps"), os.path.join(out, "ramps")
+            for directory, group in ((steps_dir, runs), (ramps_dir, ramps)):
+                os.makedirs(os.path.join(directory, "runs"))
+                for index, run in enumerate(group):
+                    os.rename(run, os.path.join(directory, "runs", f"run_{index:03d}"))
+            values = calibrate(source_dir, [steps_dir, ramps_dir], ["--drive-lag"] + extra, fitted)
+            if values is None:
+                return 1
+            for key, made, tolerance in (("command_lag_s", DRIVE["tau"], 0.005),
+                                         ("command_lag_w_s", DRIVE["tau_w"], 0.005),
+                                         ("command_max_accel_mps2", DRIVE["max_accel"], 0.08)):
+                print(f"fitted {key}: {values[key]:.4g} (made {made})")
+                if abs(values[key] - made) > tolerance:
+                    problems.append(f"{key}: fitted {values[key]:.4g}, made {made} (tolerance "
+                                    f"{tolerance})")
+            # One lag for both cannot be the speed's: the runs test the model.
+            one = calibrate(source_dir, [steps_dir, ramps_dir], [], fitted)
+            if one is None:
+                return 1
+            print(f"without --drive-lag: command_lag_s {one['command_lag_s']:.4g}")
+            if abs(one["command_lag_s"] - DRIVE["tau"]) <= 0.005:
+                problems.append("without --drive-lag the one lag is still the speed's: the runs "
+                                "do not test the drive's model")
         else:
-            print(f"unknown case {case!r}: expected regime, wheels, spot or straight")
+            print(f"unknown case {case!r}: expected regime, wheels, spot, straight or drive")
             return 2
         for problem in problems:
             print(problem)

@@ -38,6 +38,8 @@ void ExpectPaperChoices(const app::RunConfig& config) {
   EXPECT_EQ(ekf.command_noise.lag_noise_fraction, 0.0);
   EXPECT_EQ(ekf.command_gain_v, 1.0);
   EXPECT_EQ(ekf.command_gain_w, 1.0);
+  EXPECT_EQ(ekf.Following().lag_w_s, 0.0);
+  EXPECT_EQ(ekf.command_max_accel_mps2, 0.0);
   EXPECT_EQ(ekf.command_lag_s, 0.0);
   EXPECT_EQ(ekf.jacobians, "current");
   EXPECT_EQ(ekf.max_updates, 2);

@@ -1,6 +1,6 @@
 // First-estimates Jacobians (slam.ekf.jacobians: first_estimates; docs/method.md,
 // departure 20) and the command-following model (slam.ekf.command_gain_v, _w,
-// command_lag_s; departure 21).
+// command_lag_s, command_lag_w_s, command_max_accel_mps2; departures 21 and 27).
 //
 // The observability test: a robot whose initial pose is uncertain (0.3 m,
 // 0.1 rad) drives around the pillar of a synthetic room (tests/support/
@@ -192,16 +192,50 @@ TEST(CommandLagTest, FollowsTheCommandThroughAFirstOrderLag) {
   const Twist2 command{0.4, -1.0};
   const Twist2 rest{0.0, 0.0};
   // No lag: the command itself.
-  EXPECT_EQ(FollowCommand(rest, command, 0.1, 0.0).v_mps, 0.4);
+  EXPECT_EQ(FollowCommand(rest, command, 0.1, CommandFollowing{}).v_mps, 0.4);
   // tau = dt / ln 2: half of the way in one step, three quarters in two.
   const double tau = 0.1 / std::log(2.0);
-  const Twist2 one = FollowCommand(rest, command, 0.1, tau);
+  const CommandFollowing lag{tau, tau, 0.0};
+  const Twist2 one = FollowCommand(rest, command, 0.1, lag);
   EXPECT_NEAR(one.v_mps, 0.2, 1e-15);
   EXPECT_NEAR(one.w_radps, -0.5, 1e-15);
-  const Twist2 two = FollowCommand(one, command, 0.1, tau);
+  const Twist2 two = FollowCommand(one, command, 0.1, lag);
   EXPECT_NEAR(two.v_mps, 0.3, 1e-15);
   // dt = 0 does not move.
-  EXPECT_EQ(FollowCommand(one, command, 0.0, tau).v_mps, one.v_mps);
+  EXPECT_EQ(FollowCommand(one, command, 0.0, lag).v_mps, one.v_mps);
+}
+
+TEST(CommandLagTest, TheTurnRateFollowsThroughItsOwnLag) {
+  const double half = 0.1 / std::log(2.0);     // half of the way in a step
+  const double quarter = 0.1 / std::log(4.0);  // three quarters
+  const Twist2 one = FollowCommand(Twist2{0.0, 0.0}, Twist2{0.4, -1.0}, 0.1,
+                                   CommandFollowing{half, quarter, 0.0});
+  EXPECT_NEAR(one.v_mps, 0.2, 1e-15);
+  EXPECT_NEAR(one.w_radps, -0.75, 1e-15);
+  // EkfParams: a negative command_lag_w_s is command_lag_s, else its own.
+  EkfParams params;
+  params.command_lag_s = half;
+  EXPECT_EQ(params.Following().lag_w_s, half);
+  params.command_lag_w_s = quarter;
+  EXPECT_EQ(params.Following().lag_w_s, quarter);
+  EXPECT_EQ(params.Following().lag_v_s, half);
+}
+
+TEST(CommandLagTest, TheSpeedsChangeIsLimitedOnTopOfTheLag) {
+  const double half = 0.1 / std::log(2.0);
+  const CommandFollowing limited{half, half, 0.8};  // 0.08 m/s a step at most
+  // A large step: the lag would move 0.2 m/s, the limit lets 0.08 through.
+  const Twist2 large = FollowCommand(Twist2{0.0, 0.0}, Twist2{0.4, -1.0}, 0.1, limited);
+  EXPECT_NEAR(large.v_mps, 0.08, 1e-15);
+  EXPECT_NEAR(large.w_radps, -0.5, 1e-15);  // the turn rate is not limited
+  // Braking likewise.
+  EXPECT_NEAR(FollowCommand(Twist2{0.4, 0.0}, Twist2{0.0, 0.0}, 0.1, limited).v_mps, 0.32, 1e-15);
+  // A small step (0.1 m/s: the lag moves 0.05) is followed through the lag alone.
+  EXPECT_NEAR(FollowCommand(Twist2{0.3, 0.0}, Twist2{0.4, 0.0}, 0.1, limited).v_mps, 0.35, 1e-15);
+  // Without a lag the limit alone.
+  EXPECT_NEAR(FollowCommand(Twist2{0.0, 0.0}, Twist2{0.4, 0.0}, 0.1, CommandFollowing{0.0, 0.0, 0.8})
+                  .v_mps,
+              0.08, 1e-15);
 }
 
 TEST(CommandLagTest, FilterPredictsWithTheLaggedSpeeds) {
@@ -216,6 +250,13 @@ TEST(CommandLagTest, FilterPredictsWithTheLaggedSpeeds) {
   EXPECT_NEAR(filter.X_WR().x, 0.02, 1e-12);
   filter.Step(record, nullptr);  // then 0.3 m/s
   EXPECT_NEAR(filter.X_WR().x, 0.05, 1e-12);
+  // With the speed's change limited to 0.8 m/s^2: 0.08, then 0.16 m/s.
+  params.command_max_accel_mps2 = 0.8;
+  EkfSlam limited(params, CorrectionMode::kClassical, Pose2(), Pose2());
+  limited.Step(record, nullptr);
+  EXPECT_NEAR(limited.X_WR().x, 0.008, 1e-12);
+  limited.Step(record, nullptr);
+  EXPECT_NEAR(limited.X_WR().x, 0.024, 1e-12);
 }
 
 TEST(CommandGainTest, NonPositiveGainIsABadKey) {
@@ -233,6 +274,16 @@ TEST(CommandGainTest, NonPositiveGainIsABadKey) {
   params.command_lag_s = -0.1;
   found = false;
   for (const ParamProblem& problem : params.Validate()) found |= problem.key == "command_lag_s";
+  EXPECT_TRUE(found);
+  params.command_lag_s = 0.0;
+  params.command_max_accel_mps2 = -0.8;
+  found = false;
+  for (const ParamProblem& problem : params.Validate()) found |= problem.key == "command_max_accel_mps2";
+  EXPECT_TRUE(found);
+  params.command_max_accel_mps2 = 0.0;
+  params.command_lag_w_s = std::nan("");
+  found = false;
+  for (const ParamProblem& problem : params.Validate()) found |= problem.key == "command_lag_w_s";
   EXPECT_TRUE(found);
 }
 
