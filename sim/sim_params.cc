@@ -15,6 +15,8 @@ std::vector<ParamProblem> SimParams::Validate() const {
   // Beyond a third, 1 + e would often be negative: the wheels would turn backwards.
   check.InRange("drive_disturbance_std_fraction", drive_disturbance_std_fraction, 0.0, 0.3);
   check.OneOf("drive_disturbance", drive_disturbance, {"twist", "wheels"});
+  check.NonNegative("command_accel_mps2", command_accel_mps2);
+  check.NonNegative("command_accel_radps2", command_accel_radps2);
   return check.problems();
 }
 

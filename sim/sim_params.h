@@ -47,6 +47,13 @@ struct SimParams {
   /// which the twist's factors never do (docs/method.md, "Calibrating the
   /// process noise").
   std::string drive_disturbance = "twist";
+  /// The drive's own acceleration limits (a Pioneer's microcontroller ramps
+  /// its set points: ARCOS's SETA, SETRA): at every physics step the
+  /// twist the wheel set points are made from moves toward the command by at
+  /// most these times the timestep, m/s^2 and rad/s^2. 0 (the default): the
+  /// set points jump to the command.
+  double command_accel_mps2 = 0.0;
+  double command_accel_radps2 = 0.0;
 
   template <typename Archive>
   void Serialize(Archive* a) {
@@ -56,6 +63,8 @@ struct SimParams {
     a->Visit(MJSLAM_NVP(wheel_speed_ki_nm_per_rad));
     a->Visit(MJSLAM_NVP(drive_disturbance_std_fraction));
     a->Visit(MJSLAM_NVP(drive_disturbance));
+    a->Visit(MJSLAM_NVP(command_accel_mps2));
+    a->Visit(MJSLAM_NVP(command_accel_radps2));
   }
   std::vector<ParamProblem> Validate() const;
   void ValidateOrThrow() const { ThrowIfProblems(Validate()); }

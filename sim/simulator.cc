@@ -103,6 +103,10 @@ struct Simulator::Impl {
 
   Pose2 X_RS;
   Twist2 command;
+  // The twist the set points are made from: the command, or with the
+  // drive's acceleration limits the command ramped (from rest).
+  Twist2 ramped;
+  bool Ramps() const { return sim.command_accel_mps2 > 0.0 || sim.command_accel_radps2 > 0.0; }
   // The drive's disturbance: the set points are those of (v v, w w) of these.
   Twist2 drive_factors{1.0, 1.0};
   // Each wheel's disturbance: its set point times these (left, right).
@@ -135,7 +139,8 @@ struct Simulator::Impl {
   void CheckOnFloor() const;
   // The wheel-speed set points of the command, scaled by the drive's factors.
   void ApplySetPoints() {
-    const Twist2 asked{command.v_mps * drive_factors.v_mps, command.w_radps * drive_factors.w_radps};
+    const Twist2& twist = Ramps() ? ramped : command;
+    const Twist2 asked{twist.v_mps * drive_factors.v_mps, twist.w_radps * drive_factors.w_radps};
     const WheelSpeeds wheels = WheelSpeedsFromTwist(asked, robot);
     speed_setpoint_radps = {wheels.left_radps * wheel_factors[0],
                             wheels.right_radps * wheel_factors[1]};
@@ -232,6 +237,16 @@ void Simulator::Impl::Settle() {
 }
 
 void Simulator::Impl::Step() {
+  if (Ramps()) {
+    auto toward = [this](double from, double to, double limit) {
+      if (limit <= 0.0) return to;
+      const double most = limit * m->opt.timestep;
+      return from + std::clamp(to - from, -most, most);
+    };
+    ramped = Twist2{toward(ramped.v_mps, command.v_mps, sim.command_accel_mps2),
+                    toward(ramped.w_radps, command.w_radps, sim.command_accel_radps2)};
+    ApplySetPoints();
+  }
   // Wheel-speed PI control, torque clamped to the actuator range; the error
   // integrates only while the torque is not saturated (or it helps unwind).
   for (int i = 0; i < 2; ++i) {

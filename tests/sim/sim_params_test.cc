@@ -38,6 +38,10 @@ std::vector<std::string> ProblemKeys(const std::vector<ParamProblem>& problems) 
 
 TEST(SimParamsTest, DefaultsAreValid) {
   EXPECT_TRUE(SimParams{}.Validate().empty());
+  SimParams negative_ramp;
+  negative_ramp.command_accel_radps2 = -1.0;
+  ASSERT_EQ(negative_ramp.Validate().size(), 1u);
+  EXPECT_EQ(negative_ramp.Validate()[0].key, "command_accel_radps2");
   EXPECT_TRUE(RobotParams{}.Validate().empty());
   EXPECT_TRUE(LaserParams{}.Validate().empty());
   EXPECT_TRUE(OdometryParams{}.Validate().empty());
@@ -57,7 +61,8 @@ TEST(SimParamsTest, SerializeVisitsEveryFieldUnderItsKey) {
             (std::vector<std::string>{"timestep_s", "settle_time_s", "wheel_speed_kp_nms_per_rad",
                                       "wheel_speed_ki_nm_per_rad",
                                       "drive_disturbance_std_fraction",
-                                      "drive_disturbance"}));
+                                      "drive_disturbance", "command_accel_mps2",
+                                      "command_accel_radps2"}));
   EXPECT_EQ(Keys<RobotParams>(),
             (std::vector<std::string>{"control_point_offset_m", "wheel_radius_m", "axle_track_m",
                                       "max_wheel_speed_radps", "max_linear_speed_mps",

@@ -116,6 +116,36 @@ TEST_F(SimulatorDriveTest, WheelFactorsScaleEachWheelsSetPoint) {
   EXPECT_NEAR(straight.v_mps, 0.5, 0.01);
 }
 
+// The drive's own acceleration limits (sim.command_accel_mps2, _radps2): the
+// set points ramp toward the command, so after 0.5 s of a step to 0.4 m/s and
+// 1 rad/s at 0.3 m/s^2 and 1.745 rad/s^2 the robot is near 0.15 m/s and 0.87
+// rad/s (the ramp's values, less the wheels' lag behind them), and without
+// the limits it has reached the command.
+TEST_F(SimulatorDriveTest, TheDrivesAccelerationLimitsRampTheSetPoints) {
+  const auto after = [&](double accel_mps2, double accel_radps2, double seconds) {
+    SimParams params;
+    params.command_accel_mps2 = accel_mps2;
+    params.command_accel_radps2 = accel_radps2;
+    Simulator sim(EmptyWorld(), RobotModelPath(), params, RobotParams{}, Pose2(0, 0, 0));
+    sim.SetCommand({0.4, 1.0});
+    sim.Advance(seconds);
+    EXPECT_DOUBLE_EQ(sim.command().v_mps, 0.4);  // the command as given
+    return sim.TrueTwist();
+  };
+  const Twist2 ramped = after(0.3, 1.745, 0.5);
+  EXPECT_LT(ramped.v_mps, 0.15);
+  EXPECT_GT(ramped.v_mps, 0.12);
+  EXPECT_LT(ramped.w_radps, 0.8725);
+  EXPECT_GT(ramped.w_radps, 0.75);
+  const Twist2 free = after(0.0, 0.0, 0.5);
+  EXPECT_NEAR(free.v_mps, 0.4, 0.01);
+  EXPECT_NEAR(free.w_radps, 1.0, 0.03);
+  // The ramp ends at the command.
+  const Twist2 later = after(0.3, 1.745, 2.5);
+  EXPECT_NEAR(later.v_mps, 0.4, 0.01);
+  EXPECT_NEAR(later.w_radps, 1.0, 0.03);
+}
+
 // Drives straight with `speed` until the point h has covered 5 m; returns the
 // heading change (rad) and the lateral offset (m) from the start line.
 std::pair<double, double> DriveStraightFiveMetres(double speed_mps) {
