@@ -66,8 +66,9 @@ Eigen::Vector3d PredictPose(const Eigen::Vector3d& pose_WR, const Eigen::Vector2
                             const TurnCentre& turn_centre = TurnCentre());
 
 /// The speeds the robot moves at over a step of `dt_s` (>= 0) when it
-/// follows `command` as `following` says (CommandFollowing), having moved at `followed` over the step before: each
-/// component through a first-order lag of its own time constant tau,
+/// follows `command` as `following` says, having moved at `followed` over
+/// the step before: each component through a first-order lag of its own
+/// time constant tau,
 ///   followed + (1 - exp(-dt / tau)) (command - followed)
 /// (tau = 0: the command itself), the speed's change over the step then
 /// held within +-max_accel dt when a limit is set (the drive's torque

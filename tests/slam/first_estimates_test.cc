@@ -233,9 +233,9 @@ TEST(CommandLagTest, TheSpeedsChangeIsLimitedOnTopOfTheLag) {
   // A small step (0.1 m/s: the lag moves 0.05) is followed through the lag alone.
   EXPECT_NEAR(FollowCommand(Twist2{0.3, 0.0}, Twist2{0.4, 0.0}, 0.1, limited).v_mps, 0.35, 1e-15);
   // Without a lag the limit alone.
-  EXPECT_NEAR(FollowCommand(Twist2{0.0, 0.0}, Twist2{0.4, 0.0}, 0.1, CommandFollowing{0.0, 0.0, 0.8})
-                  .v_mps,
-              0.08, 1e-15);
+  const CommandFollowing limit_alone{0.0, 0.0, 0.8};
+  EXPECT_NEAR(FollowCommand(Twist2{0.0, 0.0}, Twist2{0.4, 0.0}, 0.1, limit_alone).v_mps, 0.08,
+              1e-15);
 }
 
 TEST(CommandLagTest, FilterPredictsWithTheLaggedSpeeds) {
@@ -278,7 +278,9 @@ TEST(CommandGainTest, NonPositiveGainIsABadKey) {
   params.command_lag_s = 0.0;
   params.command_max_accel_mps2 = -0.8;
   found = false;
-  for (const ParamProblem& problem : params.Validate()) found |= problem.key == "command_max_accel_mps2";
+  for (const ParamProblem& problem : params.Validate()) {
+    found |= problem.key == "command_max_accel_mps2";
+  }
   EXPECT_TRUE(found);
   params.command_max_accel_mps2 = 0.0;
   params.command_lag_w_s = std::nan("");
