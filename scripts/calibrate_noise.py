@@ -7,10 +7,10 @@ slam.ekf.turn_centre_offset_m_per_radps (docs/method.md, "Calibrating the proces
     scripts/calibrate_noise.py DIR [DIR ...] [--offset A] [--window L] [--no-gain]
                                [--no-lag | --drive-lag]
                                [--slip-by-regime | --slip-on-the-spot] [--turn-centre]
-                               [--lag-noise] [--wheel-noise] [--json FILE]
+                               [--lag-noise] [--wheel-noise] [--ramp A_V A_W] [--json FILE]
     scripts/calibrate_noise.py --consistency WORK --write CONFIG [--config BASE] [--seed S]
                                [--runs N] [--jobs J] [--iterations K] [--tolerance T]
-                               [--slip-on-the-spot] [--wheel-noise]
+                               [--slip-on-the-spot] [--wheel-noise] [--ramp A_V A_W]
 
 Each DIR is a run directory (with trajectory.csv) or a sweep directory (its
 runs/run_*/ are taken). For every step k of a trajectory (rows k-1 and k,
@@ -29,7 +29,10 @@ an arc along the mid-arc heading, plus a sideways skid):
   turn rate's own lag, slam.ekf.command_lag_s, command_max_accel_mps2 and
   command_lag_w_s (departure 27), each DIR weighted alike: the cost is the
   sum over the DIRs of log(mean e^2), so give one DIR per way of driving;
-  fit_drive_lag) and scaled
+  fit_drive_lag; with --ramp A_V A_W, a robot that ramps its own set points
+  toward the command at A_V m/s^2 and A_W rad/s^2, the lag follows the
+  ramped set point's mean over each step, slam.ekf.command_ramp_mps2 and
+  _radps2, departure 28: apply_ramp) and scaled
   by the gains g_v and g_w (slam.ekf.command_gain_v, _w: the
   robot's mean speed over its command), its noise growing with the change
   from the command of row k-2 and with the change one row earlier (row k-2
@@ -177,7 +180,8 @@ def read_steps(run, offset):
             continue
         d, dth, lateral = axle_increment(*true0, *true1, offset)
         d_odom, dth_odom, _ = axle_increment(*odom0, *odom1, offset)
-        steps.append({"dt": dt, "v": v, "w": w, "dv": abs(v - v_prev), "dw": abs(w - w_prev),
+        steps.append({"dt": dt, "v": v, "w": w, "sv": v, "sw": w,
+                      "dv": abs(v - v_prev), "dw": abs(w - w_prev),
                       "on_the_spot": v == 0.0 and v_prev == 0.0, "w_prev": w_prev,
                       "d": d, "dth": dth, "lateral": lateral,
                       "d_odom": d_odom, "dth_odom": dth_odom})
@@ -286,18 +290,41 @@ def follow(followed, command, dt, lag, max_accel=0.0):
     return target
 
 
+def ramp(ramped, command, dt, accel):
+    """(mean over the step, end) of a set point ramped from `ramped` toward
+    `command` at most `accel` a second (0: the command), one component of
+    slam::RampCommand."""
+    if accel <= 0.0:
+        return command, command
+    change = max(-accel * dt, min(accel * dt, command - ramped))
+    end = ramped + change
+    return end - change * (abs(change) / accel) / (2.0 * dt), end
+
+
+def apply_ramp(runs_steps, accel_v, accel_w):
+    """Sets each step's set points (sv, sw), what the lag follows: the
+    commands ramped at `accel_v` m/s^2 and `accel_w` rad/s^2 (--ramp), each
+    the ramp's mean over the step, from rest at a run's first step; without
+    a ramp (0) the commands themselves."""
+    for steps in runs_steps:
+        rv = rw = 0.0
+        for s in steps:
+            s["sv"], rv = ramp(rv, s["v"], s["dt"], accel_v)
+            s["sw"], rw = ramp(rw, s["w"], s["dt"], accel_w)
+
+
 def apply_lag(runs_steps, lag, lag_w=None, max_accel=0.0):
-    """Sets each step's followed speeds (fv, fw): the commands through a
-    first-order lag of time constant `lag` seconds (the turn rate's `lag_w`,
-    None: the same), the speed's change limited to `max_accel` m/s^2 a
-    second (0: no limit), from rest at a run's first step, as
-    slam::FollowCommand."""
+    """Sets each step's followed speeds (fv, fw): the set points (sv, sw;
+    apply_ramp) through a first-order lag of time constant `lag` seconds
+    (the turn rate's `lag_w`, None: the same), the speed's change limited to
+    `max_accel` m/s^2 a second (0: no limit), from rest at a run's first
+    step, as slam::FollowCommand."""
     lag_w = lag if lag_w is None else lag_w
     for steps in runs_steps:
         fv = fw = 0.0
         for s in steps:
-            fv = follow(fv, s["v"], s["dt"], lag, max_accel)
-            fw = follow(fw, s["w"], s["dt"], lag_w)
+            fv = follow(fv, s["sv"], s["dt"], lag, max_accel)
+            fw = follow(fw, s["sw"], s["dt"], lag_w)
             s["fv"], s["fw"] = fv, fw
 
 
@@ -788,10 +815,14 @@ def consistency(args):
     motion = os.path.join(args.consistency, "motion")
     sweep(args, motion, [])
     runs_steps, steps, c, k = read_runs([motion], args.offset)
+    if args.ramp:
+        apply_ramp(runs_steps, *args.ramp)
     lag = fit_lag(runs_steps)
     apply_lag(runs_steps, lag)
     command, gains = fit_command(runs_steps, 1, True, wheel_noise=args.wheel_noise)
     values = ekf_values(gains, lag, command, fit_odometry(steps), c, k, False)
+    if args.ramp:
+        values.update(command_ramp_mps2=args.ramp[0], command_ramp_radps2=args.ramp[1])
     if args.slip_on_the_spot:
         k0, kc = fit_slip_on_the_spot(steps, c)[:2]
         values.update(lateral_slip_std_m_per_rad=k0, lateral_slip_std_m_per_rad_per_mps=0.0,
@@ -858,6 +889,10 @@ def main():
     parser.add_argument("--lag-noise", action="store_true",
                         help="also fit a command noise growing with the gap between the command "
                              "and the followed speed (command_noise.lag_noise_fraction)")
+    parser.add_argument("--ramp", type=float, nargs=2, metavar=("A_V", "A_W"),
+                        help="the robot ramps its set points at A_V m/s^2 and A_W rad/s^2 "
+                             "(slam.ekf.command_ramp_mps2, _radps2): the followed speeds are the "
+                             "ramp's means over each step, then the lag")
     parser.add_argument("--json", help="also write the fitted values to this JSON file")
     parser.add_argument("--consistency", metavar="WORK",
                         help="run the training sweeps in WORK and scale the noise against the "
@@ -875,6 +910,10 @@ def main():
     parser.add_argument("--tolerance", type=float, default=0.1,
                         help="--consistency: stop when both means per dof are within this of 1")
     args = parser.parse_args()
+    if args.ramp and not all(math.isfinite(a) and a > 0.0 for a in args.ramp):
+        print(f"calibrate_noise: --ramp: expected two accelerations > 0 (got "
+              f"{args.ramp[0]}, {args.ramp[1]})", file=sys.stderr)
+        return 2
     if args.consistency is not None:
         if not args.write or args.dirs:
             print("calibrate_noise: --consistency needs --write CONFIG and no DIR",
@@ -900,6 +939,8 @@ def main():
     except (OSError, ValueError) as e:
         print(f"calibrate_noise: {e}", file=sys.stderr)
         return 2
+    if args.ramp:
+        apply_ramp(runs_steps, *args.ramp)
     if args.window < 1:
         print(f"calibrate_noise: --window: expected an integer >= 1 (got {args.window})",
               file=sys.stderr)
@@ -939,6 +980,9 @@ def main():
     if drive:
         print(f"    command_lag_w_s: {drive[0]:.4g}")
         print(f"    command_max_accel_mps2: {drive[1]:.4g}")
+    if args.ramp:
+        print(f"    command_ramp_mps2: {args.ramp[0]:.6g}   # --ramp, the robot's own")
+        print(f"    command_ramp_radps2: {args.ramp[1]:.6g}")
     print("    command_noise:")
     for name, value in command_noise(command, args.lag_noise).items():
         print(f"      {name}: {value:.4g}")
@@ -1026,6 +1070,8 @@ def main():
                   **ekf_values(gains, lag, command, odometry, c, k, args.lag_noise)}
         if drive:
             values.update(command_lag_w_s=drive[0], command_max_accel_mps2=drive[1])
+        if args.ramp:
+            values.update(command_ramp_mps2=args.ramp[0], command_ramp_radps2=args.ramp[1])
         if turn_centre:
             values["turn_centre_offset_m_per_radps"] = turn_centre[0]
             values["turn_centre_offset_along_alone"] = turn_centre[1]

@@ -217,8 +217,10 @@ MotionInput EkfSlam::CheckedMotionInput(const SensorRecord& record) const {
   } else {
     RequireFinite(record.command.v_mps, "record.command.v_mps");
     RequireFinite(record.command.w_radps, "record.command.w_radps");
+    const RampStep ramp = RampCommand(ramped_command_, record.command, record.dt_s,
+                                      params_.command_ramp_mps2, params_.command_ramp_radps2);
     const Twist2 followed =
-        FollowCommand(followed_command_, record.command, record.dt_s, params_.Following());
+        FollowCommand(followed_command_, ramp.mean, record.dt_s, params_.Following());
     input = CommandInput(record.command, record.dt_s, params_.command_noise, previous_command_,
                          params_.command_gain_v, params_.command_gain_w, &followed,
                          previous_change_);
@@ -251,8 +253,10 @@ void EkfSlam::Predict(const SensorRecord& record, const MotionInput& input) {
     X_OR_previous_ = record.X_OR;
     has_odometry_ = true;
   }
-  followed_command_ =
-      FollowCommand(followed_command_, record.command, record.dt_s, params_.Following());
+  const RampStep ramp = RampCommand(ramped_command_, record.command, record.dt_s,
+                                    params_.command_ramp_mps2, params_.command_ramp_radps2);
+  ramped_command_ = ramp.end;
+  followed_command_ = FollowCommand(followed_command_, ramp.mean, record.dt_s, params_.Following());
   previous_change_ = Twist2{record.command.v_mps - previous_command_.v_mps,
                             record.command.w_radps - previous_command_.w_radps};
   previous_command_ = record.command;

@@ -198,6 +198,7 @@ class EkfSlam {
   Twist2 previous_command_;    // the command of the record before (zero at first)
   Twist2 previous_change_;     // previous_command_ less the command before it (zero at first)
   Twist2 followed_command_;    // the speeds the lag model moved at (zero at first: at rest)
+  Twist2 ramped_command_;      // the robot's ramped set point (zero at first)
   std::vector<FeatureInfo> info_;
   int next_id_ = 0;
 };

@@ -1,6 +1,7 @@
 #include "slam/motion_model.h"
 
 #include <algorithm>
+#include <utility>
 #include <cmath>
 
 #include "common/angles.h"
@@ -145,6 +146,22 @@ Twist2 FollowCommand(const Twist2& followed, const Twist2& command, double dt_s,
     v = followed.v_mps + std::clamp(v - followed.v_mps, -most, most);
   }
   return Twist2{v, FollowThroughLag(followed.w_radps, command.w_radps, dt_s, following.lag_w_s)};
+}
+
+RampStep RampCommand(const Twist2& ramped, const Twist2& command, double dt_s, double accel_mps2,
+                     double accel_radps2) {
+  // One component: (mean, end).
+  auto ramp = [dt_s](double from, double to, double accel) {
+    if (accel <= 0.0) return std::pair<double, double>{to, to};
+    if (dt_s <= 0.0) return std::pair<double, double>{from, from};
+    const double change = std::clamp(to - from, -accel * dt_s, accel * dt_s);
+    const double reached_s = std::abs(change) / accel;
+    const double end = from + change;
+    return std::pair<double, double>{end - change * reached_s / (2.0 * dt_s), end};
+  };
+  const auto [v_mean, v_end] = ramp(ramped.v_mps, command.v_mps, accel_mps2);
+  const auto [w_mean, w_end] = ramp(ramped.w_radps, command.w_radps, accel_radps2);
+  return RampStep{Twist2{v_mean, w_mean}, Twist2{v_end, w_end}};
 }
 
 MotionInput CommandInput(const Twist2& command, double dt_s, const CommandNoiseParams& noise,

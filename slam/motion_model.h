@@ -77,6 +77,19 @@ Eigen::Vector3d PredictPose(const Eigen::Vector3d& pose_WR, const Eigen::Vector2
 Twist2 FollowCommand(const Twist2& followed, const Twist2& command, double dt_s,
                      const CommandFollowing& following);
 
+/// A robot's own ramp of its set points (departure 28): over a step of
+/// `dt_s` (>= 0) the set point moves from `ramped` toward `command` at
+/// `accel_mps2` (speed) and `accel_radps2` (turn rate) until it reaches the
+/// command, then holds. RampStep's `end` is where it is at the end of the
+/// step, `mean` its mean over the step, what the wheels then follow (a
+/// component whose acceleration is <= 0 is not ramped: both the command).
+struct RampStep {
+  Twist2 mean;
+  Twist2 end;
+};
+RampStep RampCommand(const Twist2& ramped, const Twist2& command, double dt_s, double accel_mps2,
+                     double accel_radps2);
+
 /// The command held over `dt_s` (>= 0) as an input: increment (g_v v dt,
 /// g_w w dt) of the speeds (v, w) the robot moves at, `*followed` when not
 /// null (FollowCommand) else `command`, with the gains `gain_v`, `gain_w`

@@ -82,6 +82,8 @@ std::vector<ParamProblem> EkfParams::Validate() const {
   check.Require(std::isfinite(command_lag_w_s), "command_lag_w_s", command_lag_w_s,
                 "a finite value (negative: command_lag_s)");
   check.NonNegative("command_max_accel_mps2", command_max_accel_mps2);
+  check.NonNegative("command_ramp_mps2", command_ramp_mps2);
+  check.NonNegative("command_ramp_radps2", command_ramp_radps2);
   check.Merge("command_noise", command_noise.Validate());
   check.Merge("odometry_noise", odometry_noise.Validate());
   check.NonNegative("lateral_slip_std_m_per_rad", lateral_slip_std_m_per_rad);

@@ -220,7 +220,16 @@ struct EkfParams {
   /// through the lag (departure 27). 0 (the default): no limit.
   /// Identified by scripts/calibrate_noise.py --drive-lag.
   double command_max_accel_mps2 = 0.0;
-  /// The three above as FollowCommand takes them.
+  /// The robot's own ramp of its set points toward each new command, m/s^2
+  /// (>= 0), `input: command` only: the prediction follows, through the
+  /// lag, the ramped set point's mean over each step (RampCommand; the
+  /// simulator's sim.command_accel_mps2; departure 28). 0 (the default, the
+  /// paper's): the command itself. Known from the robot's controller, not
+  /// fitted (scripts/calibrate_noise.py --ramp takes it).
+  double command_ramp_mps2 = 0.0;
+  /// Same for the turn rate, rad/s^2 (sim.command_accel_radps2).
+  double command_ramp_radps2 = 0.0;
+  /// The lags and the limit above as FollowCommand takes them.
   CommandFollowing Following() const {
     return CommandFollowing{command_lag_s, command_lag_w_s < 0.0 ? command_lag_s : command_lag_w_s,
                             command_max_accel_mps2};
@@ -361,6 +370,8 @@ struct EkfParams {
     a->Visit(MJSLAM_NVP(command_lag_s));
     a->Visit(MJSLAM_NVP(command_lag_w_s));
     a->Visit(MJSLAM_NVP(command_max_accel_mps2));
+    a->Visit(MJSLAM_NVP(command_ramp_mps2));
+    a->Visit(MJSLAM_NVP(command_ramp_radps2));
     a->Visit(MJSLAM_NVP(command_noise));
     a->Visit(MJSLAM_NVP(odometry_noise));
     a->Visit(MJSLAM_NVP(lateral_slip_std_m_per_rad));

@@ -3,7 +3,9 @@
 lag, the settling wheels' noise, the sideways slip by regime and the point beside the axle a
 robot turning on the spot turns about, of a robot made with known ones (case `regime`); the
 noise of wheels that vary each on its own (case `wheels`); the sideways slip on the spot of a
-robot whose sideways motion while moving has another form (case `spot`).
+robot whose sideways motion while moving has another form (case `spot`); runs that never turn
+(`straight`); the drive's lags and limit (`drive`); the lag behind a robot's own ramp of its set
+points (`ramp`).
 
     /usr/bin/python3 tests/integration/calibrate_noise_test.py SOURCE_DIR [CASE] [OPTION ...]
 
@@ -70,6 +72,14 @@ of a ramp (0.05 m/s a row up to 0.4 m/s and down, no turn) in another. Asserted:
 0.005 s and the limit within 0.08 m/s^2 of their values; and, fitted without --drive-lag, the
 one lag more than 0.005 s off the speed's (the runs test the model).
 
+Case `ramp` (--ramp 0.3 1.745): the robot of case `regime` whose controller ramps its set points
+toward each command at RAMP = (0.3 m/s^2, 1.745 rad/s^2) before the lag (slam.ekf.command_ramp_mps2,
+_radps2, departure 28; the lag follows the ramped set point's mean over each row, as
+slam::RampCommand). Asserted: the lag within 0.005 s of TAU and the gains as in case `regime`,
+the ramp's rates written as given; and, fitted without --ramp, the lag more than 0.05 s off (the
+ramp taken for a lag: 0.43 s fitted; 0.052 with it). Shown by hand to fail with the ramp's end in
+place of its mean in the script (the lag 0.109 fitted).
+
 Exit status 0 when the values are recovered, 1 with the reasons otherwise.
 """
 import csv
@@ -98,10 +108,19 @@ TURN_V = 0.005   # m/s per rad/s (the wheels case)
 SPEED_W = 0.02   # rad/s per m/s (the wheels case)
 MOVING_SIDEWAYS = 5e-5  # m a step, moving (the spot case)
 DRIVE = {"tau": 0.03, "tau_w": 0.07, "max_accel": 0.8}  # the drive case (departure 27)
+RAMP = (0.3, 1.745)  # the ramp case: the set points' ramp, m/s^2 and rad/s^2 (departure 28)
+
+
+def ramp_step(ramped, command, accel):
+    """(mean over the row, end) of a set point ramped from `ramped` toward
+    `command` at `accel` a second (slam::RampCommand's arithmetic)."""
+    change = max(-accel * DT, min(accel * DT, command - ramped))
+    end = ramped + change
+    return end - change * (abs(change) / accel) / (2.0 * DT), end
 
 
 def write_run(directory, seed, turn_v=0.0, speed_w=0.0, spot=False, straight=False, tau=TAU,
-              tau_w=TAU, max_accel=0.0, ramp=False):
+              tau_w=TAU, max_accel=0.0, ramp=False, set_point_ramp=None):
     """One run's trajectory.csv with the columns calibrate_noise.py reads:
     the robot of the module's docstring, its speed's noise growing by
     `turn_v` times the turn rate followed and its turn rate's by `speed_w`
@@ -114,13 +133,15 @@ def write_run(directory, seed, turn_v=0.0, speed_w=0.0, spot=False, straight=Fal
     the turn rate through a lag of `tau_w`; with `ramp` the speed command
     climbs from rest to 0.4 m/s in steps of 0.05 m/s a row, holds for 30
     rows and comes down likewise, the turn rate 0 (the tour's way of
-    driving)."""
+    driving); with `set_point_ramp` (m/s^2, rad/s^2) the lag follows the
+    commands ramped at those rates, each the ramp's mean over the row."""
     rng = random.Random(seed)
     slip_rng = random.Random(seed + 1000)
     os.makedirs(directory)
     x = y = th = 0.0
     fv = fw = 0.0
     v = w = 0.0
+    ramped = [0.0, 0.0]    # the ramped set points (with set_point_ramp)
     previous = [0.0, 0.0]  # the command of the row before (at rest before the first)
     settle = [0.0, 0.0]    # |change| of the command at the row before
     beta = 1.0 - math.exp(-DT / tau)
@@ -141,11 +162,15 @@ def write_run(directory, seed, turn_v=0.0, speed_w=0.0, spot=False, straight=Fal
             rx, ry = x + OFFSET * math.cos(th), y + OFFSET * math.sin(th)
             odometry = [rx + rng.gauss(0, 1e-4), ry + rng.gauss(0, 1e-4), th + rng.gauss(0, 1e-4)]
             writer.writerow([f"{k * DT:.3f}", rx, ry, th, *odometry, v, w])
-            change = beta * (v - fv)
+            set_v, set_w = v, w
+            if set_point_ramp:
+                set_v, ramped[0] = ramp_step(ramped[0], v, set_point_ramp[0])
+                set_w, ramped[1] = ramp_step(ramped[1], w, set_point_ramp[1])
+            change = beta * (set_v - fv)
             if max_accel > 0.0:
                 change = max(-max_accel * DT, min(max_accel * DT, change))
             fv += change
-            fw += beta_w * (w - fw)
+            fw += beta_w * (set_w - fw)
             d = (GAIN_V * fv + rng.gauss(0, 0.001 + SETTLE * settle[0]
                                          + LAG_NOISE * abs(v - fv) + turn_v * abs(fw))) * DT
             dth = (GAIN_W * fw + rng.gauss(0, 0.005 + SETTLE * settle[1]
@@ -249,7 +274,8 @@ def main(source_dir, case, extra):
         robot = {"wheels": {"turn_v": TURN_V, "speed_w": SPEED_W},
                  "drive": DRIVE,
                  "spot": {"spot": True},
-                 "straight": {"turn_v": TURN_V, "speed_w": SPEED_W, "straight": True}}.get(case, {})
+                 "straight": {"turn_v": TURN_V, "speed_w": SPEED_W, "straight": True},
+                 "ramp": {"set_point_ramp": RAMP}}.get(case, {})
         runs = []
         for seed in (1, 2, 3):
             runs.append(os.path.join(out, f"run_{seed}"))
@@ -358,8 +384,28 @@ def main(source_dir, case, extra):
             if abs(one["command_lag_s"] - DRIVE["tau"]) <= 0.005:
                 problems.append("without --drive-lag the one lag is still the speed's: the runs "
                                 "do not test the drive's model")
+        elif case == "ramp":
+            ramp = ["--ramp", str(RAMP[0]), str(RAMP[1])]
+            values = calibrate(source_dir, runs, REGIME + ramp + extra, fitted)
+            if values is None:
+                return 1
+            problems += [p for p in check_regime(values, lag_noise=False)
+                         if p.split(":")[0] in ("command_lag_s", "command_gain_v",
+                                                "command_gain_w")]
+            if (values.get("command_ramp_mps2"), values.get("command_ramp_radps2")) != RAMP:
+                problems.append(f"the ramp's rates written: {values.get('command_ramp_mps2')}, "
+                                f"{values.get('command_ramp_radps2')}, expected {RAMP}")
+            # Without the ramp the fit takes it for a long lag: the runs test it.
+            without = calibrate(source_dir, runs, REGIME, fitted)
+            if without is None:
+                return 1
+            print(f"without --ramp: command_lag_s {without['command_lag_s']:.4g}")
+            if abs(without["command_lag_s"] - TAU) <= 0.05:
+                problems.append("without --ramp the lag is still within 0.05 s of the robot's: "
+                                "the runs do not test the ramp")
         else:
-            print(f"unknown case {case!r}: expected regime, wheels, spot, straight or drive")
+            print(f"unknown case {case!r}: expected regime, wheels, spot, straight, drive or "
+                  "ramp")
             return 2
         for problem in problems:
             print(problem)

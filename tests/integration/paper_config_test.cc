@@ -40,6 +40,8 @@ void ExpectPaperChoices(const app::RunConfig& config) {
   EXPECT_EQ(ekf.command_gain_w, 1.0);
   EXPECT_EQ(ekf.Following().lag_w_s, 0.0);
   EXPECT_EQ(ekf.command_max_accel_mps2, 0.0);
+  EXPECT_EQ(ekf.command_ramp_mps2, 0.0);
+  EXPECT_EQ(ekf.command_ramp_radps2, 0.0);
   EXPECT_EQ(ekf.command_lag_s, 0.0);
   EXPECT_EQ(ekf.jacobians, "current");
   EXPECT_EQ(ekf.max_updates, 2);

@@ -1,6 +1,7 @@
 // First-estimates Jacobians (slam.ekf.jacobians: first_estimates; docs/method.md,
 // departure 20) and the command-following model (slam.ekf.command_gain_v, _w,
-// command_lag_s, command_lag_w_s, command_max_accel_mps2; departures 21 and 27).
+// command_lag_s, command_lag_w_s, command_max_accel_mps2; departures 21 and 27), and the ramp of
+// the set points (command_ramp_mps2, _radps2; departure 28).
 //
 // The observability test: a robot whose initial pose is uncertain (0.3 m,
 // 0.1 rad) drives around the pillar of a synthetic room (tests/support/
@@ -259,6 +260,54 @@ TEST(CommandLagTest, FilterPredictsWithTheLaggedSpeeds) {
   EXPECT_NEAR(limited.X_WR().x, 0.024, 1e-12);
 }
 
+TEST(CommandRampTest, RampsTowardTheCommandAndAveragesOverTheStep) {
+  // From rest toward 0.4 m/s at 0.3 m/s^2: 0.03 m/s gained over the whole
+  // step, so the end 0.03 and the mean 0.015; the turn rate toward -1 rad/s
+  // at 1.745 rad/s^2 likewise (-0.1745, mean half of it).
+  const RampStep from_rest = RampCommand(Twist2{0.0, 0.0}, Twist2{0.4, -1.0}, 0.1, 0.3, 1.745);
+  EXPECT_NEAR(from_rest.end.v_mps, 0.03, 1e-15);
+  EXPECT_NEAR(from_rest.mean.v_mps, 0.015, 1e-15);
+  EXPECT_NEAR(from_rest.end.w_radps, -0.1745, 1e-15);
+  EXPECT_NEAR(from_rest.mean.w_radps, -0.08725, 1e-15);
+  // A small change, reached within the step (0.01 m/s in 1/30 s, then
+  // held): the mean (0.305 for 1/30 s, 0.31 for 2/30 s) is 0.308333.
+  const RampStep small = RampCommand(Twist2{0.3, 0.0}, Twist2{0.31, 0.0}, 0.1, 0.3, 1.745);
+  EXPECT_NEAR(small.end.v_mps, 0.31, 1e-15);
+  EXPECT_NEAR(small.mean.v_mps, 0.3 + (0.005 / 3.0 + 0.02 / 3.0), 1e-15);
+  // Braking is ramped alike.
+  EXPECT_NEAR(RampCommand(Twist2{0.4, 0.0}, Twist2{0.0, 0.0}, 0.1, 0.3, 1.745).end.v_mps, 0.37,
+              1e-15);
+  // No ramp (0): the command; no time: where it was.
+  const RampStep none = RampCommand(Twist2{0.0, 0.0}, Twist2{0.4, -1.0}, 0.1, 0.0, 0.0);
+  EXPECT_EQ(none.mean.v_mps, 0.4);
+  EXPECT_EQ(none.end.w_radps, -1.0);
+  const RampStep still = RampCommand(Twist2{0.2, 0.5}, Twist2{0.4, -1.0}, 0.0, 0.3, 1.745);
+  EXPECT_EQ(still.mean.v_mps, 0.2);
+  EXPECT_EQ(still.end.w_radps, 0.5);
+}
+
+TEST(CommandRampTest, FilterPredictsWithTheRampsMeanBeforeTheLag) {
+  EkfParams params;
+  params.command_ramp_mps2 = 0.3;
+  params.lateral_skid_s = 0.0;
+  EkfSlam filter(params, CorrectionMode::kClassical, Pose2(), Pose2());
+  SensorRecord record;
+  record.dt_s = 0.1;
+  record.command = Twist2{0.4, 0.0};
+  filter.Step(record, nullptr);  // the set point's mean 0.015 m/s over the step
+  EXPECT_NEAR(filter.X_WR().x, 0.0015, 1e-12);
+  filter.Step(record, nullptr);  // then from 0.03 to 0.06: 0.045 m/s
+  EXPECT_NEAR(filter.X_WR().x, 0.006, 1e-12);
+  // With the lag on top (half of the way a step): 0.0075 m/s, then
+  // 0.0075 + (0.045 - 0.0075) / 2 = 0.02625 m/s.
+  params.command_lag_s = 0.1 / std::log(2.0);
+  EkfSlam lagged(params, CorrectionMode::kClassical, Pose2(), Pose2());
+  lagged.Step(record, nullptr);
+  EXPECT_NEAR(lagged.X_WR().x, 0.00075, 1e-12);
+  lagged.Step(record, nullptr);
+  EXPECT_NEAR(lagged.X_WR().x, 0.00075 + 0.002625, 1e-12);
+}
+
 TEST(CommandGainTest, NonPositiveGainIsABadKey) {
   EkfParams params;
   params.command_gain_w = 0.0;
@@ -286,6 +335,13 @@ TEST(CommandGainTest, NonPositiveGainIsABadKey) {
   params.command_lag_w_s = std::nan("");
   found = false;
   for (const ParamProblem& problem : params.Validate()) found |= problem.key == "command_lag_w_s";
+  EXPECT_TRUE(found);
+  params.command_lag_w_s = -1.0;
+  params.command_ramp_radps2 = -1.745;
+  found = false;
+  for (const ParamProblem& problem : params.Validate()) {
+    found |= problem.key == "command_ramp_radps2";
+  }
   EXPECT_TRUE(found);
 }
 
