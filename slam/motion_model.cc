@@ -1,8 +1,8 @@
 #include "slam/motion_model.h"
 
 #include <algorithm>
-#include <utility>
 #include <cmath>
+#include <utility>
 
 #include "common/angles.h"
 #include "slam/fast_wrap.h"
