@@ -7,7 +7,8 @@ slam.ekf.turn_centre_offset_m_per_radps (docs/method.md, "Calibrating the proces
     scripts/calibrate_noise.py DIR [DIR ...] [--offset A] [--window L] [--no-gain]
                                [--no-lag | --drive-lag]
                                [--slip-by-regime | --slip-on-the-spot] [--turn-centre]
-                               [--lag-noise] [--wheel-noise] [--ramp A_V A_W] [--json FILE]
+                               [--lag-noise] [--wheel-noise] [--ramp A_V A_W]
+                               [--beyond DIR [DIR ...]] [--json FILE]
     scripts/calibrate_noise.py --consistency WORK --write CONFIG [--config BASE] [--seed S]
                                [--runs N] [--jobs J] [--iterations K] [--tolerance T]
                                [--slip-on-the-spot] [--wheel-noise] [--ramp A_V A_W]
@@ -86,6 +87,19 @@ an arc along the mid-arc heading, plus a sideways skid):
   motion is taken out of the true steps before everything else is fitted to
   them: the gains, the command noise and the sideways slip are those of the
   residuals.
+
+- the range (always): the largest changes of the commanded speed and turn
+  rate from one record to the next in the DIRs, command_noise.
+  calibrated_change_v_mps and _w_radps: the model above holds for them; a
+  larger step meets the drive's torque limit. Beyond it the noise grows by
+  f c_v x in sigma_v and f c_w x in sigma_w, x the relative excess of a
+  change and of the one a record earlier (CommandInput, departure 29), with
+  f = beyond_change_noise_fraction written as 1 (BEYOND_BOUND: the excess
+  itself one standard deviation). With --beyond DIR [DIR ...], runs that go
+  beyond the range (a larger world, where the filters take longer and the
+  explorer's steps grow), f's maximum likelihood value over their steps
+  beyond, everything else held, is printed for comparison
+  (fit_beyond_change).
 
 Prints the fitted values as the YAML of configs/default.yaml's slam.ekf
 section, and for each fit the mean of (error / sigma)^2 (1 for a model that
@@ -500,6 +514,53 @@ def fit_command(runs_steps, window, with_gains=True, rounds=3, lag_noise=False,
     return full(p), gains
 
 
+# beyond_change_noise_fraction written: the excess of a change over the
+# calibrated range taken as one standard deviation of the speed's error (the
+# robot may not follow that part at all within the step). A bound, not a fit:
+# the maximum likelihood value over the steps beyond (--beyond) fits the
+# typical one, and the filters lose the map at a single 3-sigma step there
+# (docs/results.md, "Calibrated process noise").
+BEYOND_BOUND = 1.0
+
+
+def change_range(steps):
+    """(c_v, c_w): the largest changes of the commanded speed and turn rate
+    from one record to the next among `steps`, the range a fit of them covers
+    (command_noise.calibrated_change_v_mps, _w_radps; departure 29)."""
+    return max(s["dv"] for s in steps), max(s["dw"] for s in steps)
+
+
+def change_excess(s, c_v, c_w):
+    """x of CommandInput's departure 29: the relative excess of step s's
+    change of the command, and of the one a record earlier, over (c_v, c_w)."""
+    def excess(change, limit):
+        return max(0.0, change - limit) / limit if limit > 0.0 else 0.0
+    return (excess(s["dv"], c_v) + excess(s["dw"], c_w) + excess(s["dv1"], c_v)
+            + excess(s["dw1"], c_w))
+
+
+def fit_beyond_change(steps, p, gains, c_v, c_w):
+    """(f, count): command_noise.beyond_change_noise_fraction by maximum
+    likelihood over the steps whose changes go beyond (c_v, c_w), the rest of
+    the command model (`p`, `gains`) held: sigma_v + f c_v x, sigma_w + f c_w x.
+    Raises ValueError when no step goes beyond."""
+    rows = []
+    for s in steps:
+        x = change_excess(s, c_v, c_w)
+        if x > 0.0:
+            rows.append((command_sigmas(s, p), command_errors(s, gains), x))
+    if not rows:
+        raise ValueError(f"--beyond: no command change beyond the training's range "
+                         f"({c_v:.4g} m/s, {c_w:.4g} rad/s) in these runs")
+
+    def nll(log_f):
+        f = math.exp(log_f)
+        return gaussian_nll([(e, (sigma + f * limit * x) ** 2)
+                             for (sigmas, errors, x) in rows
+                             for sigma, e, limit in zip(sigmas, errors, (c_v, c_w))])
+    return math.exp(golden_section(nll, math.log(1e-4), math.log(100.0), 1e-4)), len(rows)
+
+
 def variance_ratios(runs_steps, p, lengths, gains=(1.0, 1.0)):
     """For each window length: sum of the squared summed errors over the sum
     of the model's summed variances, distance and turn (1 when the errors of
@@ -893,6 +954,12 @@ def main():
                         help="the robot ramps its set points at A_V m/s^2 and A_W rad/s^2 "
                              "(slam.ekf.command_ramp_mps2, _radps2): the followed speeds are the "
                              "ramp's means over each step, then the lag")
+    parser.add_argument("--beyond", nargs="+", metavar="DIR",
+                        help="runs whose command changes go beyond those of the DIRs (e.g. a "
+                             "larger world, where the filters take longer and the explorer's "
+                             "steps grow): print the maximum likelihood value of "
+                             "command_noise.beyond_change_noise_fraction over their steps "
+                             "beyond the DIRs' range, the rest held (departure 29)")
     parser.add_argument("--json", help="also write the fitted values to this JSON file")
     parser.add_argument("--consistency", metavar="WORK",
                         help="run the training sweeps in WORK and scale the noise against the "
@@ -971,6 +1038,22 @@ def main():
         c, k = fit_skid(steps)
     command, gains = fit_command(runs_steps, args.window, not args.no_gain,
                                  lag_noise=args.lag_noise, wheel_noise=args.wheel_noise)
+    c_v, c_w = change_range(steps)
+    beyond = None  # (fraction, steps beyond, steps) with --beyond
+    if args.beyond:
+        try:
+            beyond_runs, beyond_steps = read_runs(args.beyond, args.offset)[:2]
+            if args.ramp:
+                apply_ramp(beyond_runs, *args.ramp)
+            if drive:
+                apply_lag(beyond_runs, lag, drive[0], drive[1])
+            else:
+                apply_lag(beyond_runs, lag)
+            beyond = (*fit_beyond_change(beyond_steps, command, gains, c_v, c_w),
+                      len(beyond_steps))
+        except (OSError, ValueError) as e:
+            print(f"calibrate_noise: {e}", file=sys.stderr)
+            return 2
 
     print(f"# scripts/calibrate_noise.py: {len(steps)} steps from {len(runs)} runs")
     print("slam:\n  ekf:")
@@ -986,6 +1069,13 @@ def main():
     print("    command_noise:")
     for name, value in command_noise(command, args.lag_noise).items():
         print(f"      {name}: {value:.4g}")
+    print(f"      calibrated_change_v_mps: {c_v:.4g}   # the largest changes fitted")
+    print(f"      calibrated_change_w_radps: {c_w:.4g}")
+    print(f"      beyond_change_noise_fraction: {BEYOND_BOUND:g}   # the bound: the excess as "
+          f"one standard deviation")
+    if beyond:
+        print(f"# --beyond: {beyond[1]} of {beyond[2]} steps beyond the range; maximum "
+              f"likelihood fraction there {beyond[0]:.4g} (the typical step, not the tail)")
     print("    odometry_noise:")
     for name, value in zip(ODOMETRY_NAMES, odometry):
         print(f"      {name}: {value:.4g}")
@@ -1070,6 +1160,10 @@ def main():
                   **ekf_values(gains, lag, command, odometry, c, k, args.lag_noise)}
         if drive:
             values.update(command_lag_w_s=drive[0], command_max_accel_mps2=drive[1])
+        values["command_noise"].update(calibrated_change_v_mps=c_v, calibrated_change_w_radps=c_w,
+                                       beyond_change_noise_fraction=BEYOND_BOUND)
+        if beyond:
+            values.update(beyond_change_ml_fraction=beyond[0], beyond_steps=beyond[1])
         if args.ramp:
             values.update(command_ramp_mps2=args.ramp[0], command_ramp_radps2=args.ramp[1])
         if turn_centre:

@@ -168,6 +168,22 @@ MotionInput CommandInput(const Twist2& command, double dt_s, const CommandNoiseP
                          const Twist2& previous, double gain_v, double gain_w,
                          const Twist2* followed, const Twist2& previous_change) {
   const Twist2& speeds = followed != nullptr ? *followed : command;
+  // Departure 29: the relative excess of this record's change and the one
+  // before over the range the noise was calibrated on.
+  double beyond_v = 0.0;
+  double beyond_w = 0.0;
+  if (noise.beyond_change_noise_fraction > 0.0) {
+    auto excess = [](double change, double range) {
+      return std::max(0.0, std::abs(change) - range) / range;
+    };
+    const double cv = noise.calibrated_change_v_mps;
+    const double cw = noise.calibrated_change_w_radps;
+    const double x = excess(command.v_mps - previous.v_mps, cv) +
+                     excess(command.w_radps - previous.w_radps, cw) +
+                     excess(previous_change.v_mps, cv) + excess(previous_change.w_radps, cw);
+    beyond_v = noise.beyond_change_noise_fraction * cv * x;
+    beyond_w = noise.beyond_change_noise_fraction * cw * x;
+  }
   MotionInput input;
   input.increment =
       Eigen::Vector2d(gain_v * speeds.v_mps * dt_s, gain_w * speeds.w_radps * dt_s);
@@ -177,14 +193,14 @@ MotionInput CommandInput(const Twist2& command, double dt_s, const CommandNoiseP
        noise.change_noise_fraction * std::abs(command.v_mps - previous.v_mps) +
        noise.settle_noise_fraction * std::abs(previous_change.v_mps) +
        noise.lag_noise_fraction * std::abs(command.v_mps - speeds.v_mps) +
-       noise.turn_v_noise_m_per_rad * std::abs(speeds.w_radps));
+       noise.turn_v_noise_m_per_rad * std::abs(speeds.w_radps) + beyond_v);
   const double sigma_w =
       noise.w_noise_scale *
       (noise.w_noise_std_radps + noise.w_noise_fraction * std::abs(speeds.w_radps) +
        noise.change_noise_fraction * std::abs(command.w_radps - previous.w_radps) +
        noise.settle_noise_fraction * std::abs(previous_change.w_radps) +
        noise.lag_noise_fraction * std::abs(command.w_radps - speeds.w_radps) +
-       noise.speed_w_noise_rad_per_m * std::abs(speeds.v_mps));
+       noise.speed_w_noise_rad_per_m * std::abs(speeds.v_mps) + beyond_w);
   input.covariance = Eigen::Vector2d(dt_s * dt_s * sigma_v * sigma_v,
                                      dt_s * dt_s * sigma_w * sigma_w)
                          .asDiagonal();

@@ -99,9 +99,14 @@ RampStep RampCommand(const Twist2& ramped, const Twist2& command, double dt_s, d
 ///             + change_noise_fraction |command.v - previous.v|
 ///             + settle_noise_fraction |previous_change.v|
 ///             + lag_noise_fraction |command.v - v|
-///             + turn_v_noise_m_per_rad |w|),
-/// sigma_w likewise with w for v and speed_w_noise_rad_per_m |v| in place
-/// of the last term,
+///             + turn_v_noise_m_per_rad |w|
+///             + beyond_change_noise_fraction calibrated_change_v_mps x),
+/// sigma_w likewise with w for v, speed_w_noise_rad_per_m |v| in place of
+/// the wheels' term and calibrated_change_w_radps in the last, x the
+/// relative excess of the changes over the calibrated range (departure 29:
+/// sum over this record's change and `previous_change`, v and w, of
+/// max(0, |change| - calibrated) / calibrated; 0 unless
+/// beyond_change_noise_fraction > 0),
 /// `previous` being the command of the record before and `previous_change`
 /// the change of the command at that record (its command less the one
 /// before it; zero at the first records) (CommandNoiseParams).

@@ -46,6 +46,15 @@ std::vector<ParamProblem> CommandNoiseParams::Validate() const {
   check.NonNegative("lag_noise_fraction", lag_noise_fraction);
   check.NonNegative("turn_v_noise_m_per_rad", turn_v_noise_m_per_rad);
   check.NonNegative("speed_w_noise_rad_per_m", speed_w_noise_rad_per_m);
+  check.NonNegative("calibrated_change_v_mps", calibrated_change_v_mps);
+  check.NonNegative("calibrated_change_w_radps", calibrated_change_w_radps);
+  check.NonNegative("beyond_change_noise_fraction", beyond_change_noise_fraction);
+  if (beyond_change_noise_fraction > 0.0) {
+    check.Require(calibrated_change_v_mps > 0.0, "calibrated_change_v_mps",
+                  calibrated_change_v_mps, "a value > 0 when beyond_change_noise_fraction > 0");
+    check.Require(calibrated_change_w_radps > 0.0, "calibrated_change_w_radps",
+                  calibrated_change_w_radps, "a value > 0 when beyond_change_noise_fraction > 0");
+  }
   check.Positive("v_noise_scale", v_noise_scale);
   check.Positive("w_noise_scale", w_noise_scale);
   // A zero constant part would make a stopped robot's prediction exact.

@@ -107,6 +107,22 @@ struct CommandNoiseParams {
   /// (rad/s per m/s): each wheel's own variation turns a robot that drives
   /// straight (departure 26). 0 (the default): no such term.
   double speed_w_noise_rad_per_m = 0.0;
+  /// The largest change of the commanded speed and turn rate from one record
+  /// to the next that the noise above was calibrated on, m/s and rad/s
+  /// (scripts/calibrate_noise.py writes them): beyond them the drive meets
+  /// its torque limit and follows far more slowly than the lag says
+  /// (docs/method.md, departure 29). Used only with
+  /// `beyond_change_noise_fraction` > 0, and then both must be > 0.
+  double calibrated_change_v_mps = 0.0;
+  double calibrated_change_w_radps = 0.0;
+  /// Noise of a change beyond that range (dimensionless): with x the
+  /// relative excess of this record's change and of the one before,
+  /// x = sum of max(0, |change| - calibrated) / calibrated over v and w,
+  /// sigma_v grows by beyond_change_noise_fraction calibrated_change_v_mps x
+  /// and sigma_w by beyond_change_noise_fraction calibrated_change_w_radps x
+  /// (one wheel held at its torque limit slows the speed and the turn
+  /// alike). 0 (the default): no such term.
+  double beyond_change_noise_fraction = 0.0;
   /// Factor on the whole of sigma_v (dimensionless, > 0): the fitted shape
   /// above kept, its size set against the filters' consistency on training
   /// runs (scripts/calibrate_noise.py --nees; docs/method.md, "Calibrating the
@@ -126,6 +142,9 @@ struct CommandNoiseParams {
     a->Visit(MJSLAM_NVP(lag_noise_fraction));
     a->Visit(MJSLAM_NVP(turn_v_noise_m_per_rad));
     a->Visit(MJSLAM_NVP(speed_w_noise_rad_per_m));
+    a->Visit(MJSLAM_NVP(calibrated_change_v_mps));
+    a->Visit(MJSLAM_NVP(calibrated_change_w_radps));
+    a->Visit(MJSLAM_NVP(beyond_change_noise_fraction));
     a->Visit(MJSLAM_NVP(v_noise_scale));
     a->Visit(MJSLAM_NVP(w_noise_scale));
   }

@@ -5,7 +5,7 @@ robot turning on the spot turns about, of a robot made with known ones (case `re
 noise of wheels that vary each on its own (case `wheels`); the sideways slip on the spot of a
 robot whose sideways motion while moving has another form (case `spot`); runs that never turn
 (`straight`); the drive's lags and limit (`drive`); the lag behind a robot's own ramp of its set
-points (`ramp`).
+points (`ramp`); the noise of command changes beyond the training's range (`beyond`).
 
     /usr/bin/python3 tests/integration/calibrate_noise_test.py SOURCE_DIR [CASE] [OPTION ...]
 
@@ -80,6 +80,16 @@ the ramp's rates written as given; and, fitted without --ramp, the lag more than
 ramp taken for a lag: 0.43 s fitted; 0.052 with it). Shown by hand to fail with the ramp's end in
 place of its mean in the script (the lag 0.109 fitted).
 
+Case `beyond` (--beyond DIR): training runs whose command moves toward each new target by at
+most LIMIT = (0.1 m/s, 0.4 rad/s) a row, and runs whose command jumps to it at once, their
+speeds' noise growing by BEYOND times c_v x and c_w x, x the relative excess of the row's change
+and the one before over LIMIT (slam.ekf.command_noise.beyond_change_noise_fraction, departure
+29). Asserted: the range written is LIMIT (the training's largest changes) with the fraction
+1 (the bound), the maximum likelihood fraction printed for the jumping runs (seeds 4-6) within
+20 % of BEYOND (0.307 fitted), and --beyond on
+runs with no change beyond the range an error (exit status 2). Shown by hand to fail with the
+excess's noise not scaled by the range in the script's fit (0.075 fitted).
+
 Exit status 0 when the values are recovered, 1 with the reasons otherwise.
 """
 import csv
@@ -109,6 +119,8 @@ SPEED_W = 0.02   # rad/s per m/s (the wheels case)
 MOVING_SIDEWAYS = 5e-5  # m a step, moving (the spot case)
 DRIVE = {"tau": 0.03, "tau_w": 0.07, "max_accel": 0.8}  # the drive case (departure 27)
 RAMP = (0.3, 1.745)  # the ramp case: the set points' ramp, m/s^2 and rad/s^2 (departure 28)
+LIMIT = (0.1, 0.4)   # the beyond case: the training's largest changes, m/s and rad/s
+BEYOND = 0.3         # the beyond case: the noise of the excess (departure 29)
 
 
 def ramp_step(ramped, command, accel):
@@ -120,7 +132,8 @@ def ramp_step(ramped, command, accel):
 
 
 def write_run(directory, seed, turn_v=0.0, speed_w=0.0, spot=False, straight=False, tau=TAU,
-              tau_w=TAU, max_accel=0.0, ramp=False, set_point_ramp=None):
+              tau_w=TAU, max_accel=0.0, ramp=False, set_point_ramp=None, limit=None,
+              beyond=0.0):
     """One run's trajectory.csv with the columns calibrate_noise.py reads:
     the robot of the module's docstring, its speed's noise growing by
     `turn_v` times the turn rate followed and its turn rate's by `speed_w`
@@ -134,13 +147,18 @@ def write_run(directory, seed, turn_v=0.0, speed_w=0.0, spot=False, straight=Fal
     climbs from rest to 0.4 m/s in steps of 0.05 m/s a row, holds for 30
     rows and comes down likewise, the turn rate 0 (the tour's way of
     driving); with `set_point_ramp` (m/s^2, rad/s^2) the lag follows the
-    commands ramped at those rates, each the ramp's mean over the row."""
+    commands ramped at those rates, each the ramp's mean over the row; with
+    `limit` (m/s, rad/s) the command moves toward each new target by at most
+    that a row; with `beyond` the speeds' noise grows by `beyond` LIMIT x,
+    x the relative excess of the row's change and the one before over
+    LIMIT."""
     rng = random.Random(seed)
     slip_rng = random.Random(seed + 1000)
     os.makedirs(directory)
     x = y = th = 0.0
     fv = fw = 0.0
     v = w = 0.0
+    target = [0.0, 0.0]    # where a limited command is going (with limit)
     ramped = [0.0, 0.0]    # the ramped set points (with set_point_ramp)
     previous = [0.0, 0.0]  # the command of the row before (at rest before the first)
     settle = [0.0, 0.0]    # |change| of the command at the row before
@@ -159,6 +177,10 @@ def write_run(directory, seed, turn_v=0.0, speed_w=0.0, spot=False, straight=Fal
             elif k % (5 if spot else 20) == 0:
                 v = rng.choice([0.0, 0.0, 0.0, 0.2, 0.4] if spot else [0.0, 0.2, 0.4])
                 w = 0.0 if straight else rng.uniform(-0.8, 0.8)
+                target = [v, w]
+            if limit:
+                v = previous[0] + max(-limit[0], min(limit[0], target[0] - previous[0]))
+                w = previous[1] + max(-limit[1], min(limit[1], target[1] - previous[1]))
             rx, ry = x + OFFSET * math.cos(th), y + OFFSET * math.sin(th)
             odometry = [rx + rng.gauss(0, 1e-4), ry + rng.gauss(0, 1e-4), th + rng.gauss(0, 1e-4)]
             writer.writerow([f"{k * DT:.3f}", rx, ry, th, *odometry, v, w])
@@ -171,10 +193,15 @@ def write_run(directory, seed, turn_v=0.0, speed_w=0.0, spot=False, straight=Fal
                 change = max(-max_accel * DT, min(max_accel * DT, change))
             fv += change
             fw += beta_w * (set_w - fw)
+            excess = sum(max(0.0, change - most) / most
+                         for change, most in zip((abs(v - previous[0]), abs(w - previous[1]),
+                                                  *settle), LIMIT * 2))
             d = (GAIN_V * fv + rng.gauss(0, 0.001 + SETTLE * settle[0]
-                                         + LAG_NOISE * abs(v - fv) + turn_v * abs(fw))) * DT
+                                         + LAG_NOISE * abs(v - fv) + turn_v * abs(fw)
+                                         + beyond * LIMIT[0] * excess)) * DT
             dth = (GAIN_W * fw + rng.gauss(0, 0.005 + SETTLE * settle[1]
-                                           + LAG_NOISE * abs(w - fw) + speed_w * abs(fv))) * DT
+                                           + LAG_NOISE * abs(w - fw) + speed_w * abs(fv)
+                                           + beyond * LIMIT[1] * excess)) * DT
             on_the_spot = v == 0.0 and previous[0] == 0.0
             if spot and not on_the_spot:
                 lateral = slip_rng.gauss(0, MOVING_SIDEWAYS)
@@ -275,7 +302,8 @@ def main(source_dir, case, extra):
                  "drive": DRIVE,
                  "spot": {"spot": True},
                  "straight": {"turn_v": TURN_V, "speed_w": SPEED_W, "straight": True},
-                 "ramp": {"set_point_ramp": RAMP}}.get(case, {})
+                 "ramp": {"set_point_ramp": RAMP},
+                 "beyond": {"limit": LIMIT}}.get(case, {})
         runs = []
         for seed in (1, 2, 3):
             runs.append(os.path.join(out, f"run_{seed}"))
@@ -403,9 +431,33 @@ def main(source_dir, case, extra):
             if abs(without["command_lag_s"] - TAU) <= 0.05:
                 problems.append("without --ramp the lag is still within 0.05 s of the robot's: "
                                 "the runs do not test the ramp")
+        elif case == "beyond":
+            jumps = []
+            for seed in (4, 5, 6):
+                jumps.append(os.path.join(out, f"jump_{seed}"))
+                write_run(jumps[-1], seed, beyond=BEYOND)
+            values = calibrate(source_dir, runs, ["--beyond", *jumps] + extra, fitted)
+            if values is None:
+                return 1
+            written = (value(values, "calibrated_change_v_mps"),
+                       value(values, "calibrated_change_w_radps"))
+            print(f"range written: {written} (made {LIMIT})")
+            if any(abs(a - b) > 1e-9 for a, b in zip(written, LIMIT)):
+                problems.append(f"the range written: {written}, expected {LIMIT}")
+            problems += check_relative(values, (("beyond_change_ml_fraction", BEYOND),), 0.2)
+            if value(values, "beyond_change_noise_fraction") != 1.0:
+                problems.append("beyond_change_noise_fraction written: "
+                                f"{value(values, 'beyond_change_noise_fraction')}, expected 1")
+            # Runs that never go beyond leave nothing to fit: an error.
+            none = subprocess.run(["/usr/bin/python3",
+                                   os.path.join(source_dir, "scripts", "calibrate_noise.py"),
+                                   *runs, "--beyond", *runs], capture_output=True, text=True)
+            if none.returncode != 2 or "--beyond" not in none.stderr:
+                problems.append(f"--beyond without a change beyond: expected exit status 2 "
+                                f"naming --beyond, got {none.returncode}: {none.stderr}")
         else:
-            print(f"unknown case {case!r}: expected regime, wheels, spot, straight, drive or "
-                  "ramp")
+            print(f"unknown case {case!r}: expected regime, wheels, spot, straight, drive, "
+                  "ramp or beyond")
             return 2
         for problem in problems:
             print(problem)

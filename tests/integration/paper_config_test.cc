@@ -36,6 +36,9 @@ void ExpectPaperChoices(const app::RunConfig& config) {
   EXPECT_EQ(ekf.extra_corner_bearing_std_rad, 0.0);
   EXPECT_EQ(ekf.command_noise.change_noise_fraction, 0.0);
   EXPECT_EQ(ekf.command_noise.lag_noise_fraction, 0.0);
+  EXPECT_EQ(ekf.command_noise.turn_v_noise_m_per_rad, 0.0);
+  EXPECT_EQ(ekf.command_noise.speed_w_noise_rad_per_m, 0.0);
+  EXPECT_EQ(ekf.command_noise.beyond_change_noise_fraction, 0.0);
   EXPECT_EQ(ekf.command_gain_v, 1.0);
   EXPECT_EQ(ekf.command_gain_w, 1.0);
   EXPECT_EQ(ekf.Following().lag_w_s, 0.0);

@@ -63,6 +63,57 @@ TEST(EkfSlamTest, SettleNoiseWidensTheStepAfterAChange) {
               1e-12);
 }
 
+// Departure 29: a change of the command beyond the calibrated range widens
+// both components by the relative excess of this change and the one before;
+// within the range nothing changes.
+TEST(CommandInputTest, ChangeBeyondTheCalibratedRangeWidensBothComponents) {
+  CommandNoiseParams noise;
+  noise.v_noise_std_mps = 0.001;
+  noise.v_noise_fraction = 0.0;
+  noise.w_noise_std_radps = 0.002;
+  noise.w_noise_fraction = 0.0;
+  noise.change_noise_fraction = 0.0;
+  noise.calibrated_change_v_mps = 0.1;
+  noise.calibrated_change_w_radps = 0.4;
+  noise.beyond_change_noise_fraction = 0.5;
+  auto sigmas = [&](const Twist2& command, const Twist2& previous,
+                    const Twist2& change) -> Eigen::Vector2d {
+    const MotionInput input = CommandInput(command, 0.1, noise, previous, 1.0, 1.0, nullptr,
+                                           change);
+    return Eigen::Vector2d(std::sqrt(input.covariance(0, 0)), std::sqrt(input.covariance(1, 1))) /
+           0.1;
+  };
+  // Within the range (changes of 0.1 m/s and -0.4 rad/s): the floors alone.
+  const Eigen::Vector2d within = sigmas({0.3, -0.4}, {0.2, 0.0}, {0.1, 0.0});
+  EXPECT_NEAR(within.x(), 0.001, 1e-15);
+  EXPECT_NEAR(within.y(), 0.002, 1e-15);
+  // A turn-rate change of 1.2 rad/s, twice beyond 0.4: x = 2, and the speed
+  // widens too (f c_v x = 0.5 0.1 2, f c_w x = 0.5 0.4 2).
+  const Eigen::Vector2d turn = sigmas({0.3, 1.2}, {0.3, 0.0}, {});
+  EXPECT_NEAR(turn.x(), 0.001 + 0.1, 1e-12);
+  EXPECT_NEAR(turn.y(), 0.002 + 0.4, 1e-12);
+  // The change one record earlier counts too: 0.25 m/s, 1.5 times beyond.
+  const Eigen::Vector2d after = sigmas({0.3, 0.0}, {0.3, 0.0}, {-0.25, 0.0});
+  EXPECT_NEAR(after.x(), 0.001 + 0.5 * 0.1 * 1.5, 1e-12);
+  EXPECT_NEAR(after.y(), 0.002 + 0.5 * 0.4 * 1.5, 1e-12);
+  // Off with the fraction 0, whatever the range.
+  noise.beyond_change_noise_fraction = 0.0;
+  EXPECT_NEAR(sigmas({0.3, 1.2}, {0.3, 0.0}, {}).y(), 0.002, 1e-15);
+}
+
+TEST(CommandInputTest, BeyondChangeNeedsItsRange) {
+  CommandNoiseParams noise;
+  noise.beyond_change_noise_fraction = 0.1;
+  noise.calibrated_change_w_radps = 0.4;
+  const std::vector<ParamProblem> problems = noise.Validate();
+  ASSERT_EQ(problems.size(), 1u);
+  EXPECT_EQ(problems[0].key, "calibrated_change_v_mps");
+  noise.calibrated_change_v_mps = -0.1;
+  EXPECT_FALSE(noise.Validate().empty());
+  noise.calibrated_change_v_mps = 0.1;
+  EXPECT_TRUE(noise.Validate().empty());
+}
+
 // The sideways slip by regime (lateral_slip_std_m_per_rad_per_mps,
 // lateral_slip_std_m_per_radps_change): with every other noise off, the
 // position's variance is the slips' alone, added across the heading.
