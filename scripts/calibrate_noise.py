@@ -5,7 +5,7 @@ slam.ekf.lateral_skid_s, slam.ekf.lateral_slip_std_m_per_rad (and by regime) and
 slam.ekf.turn_centre_offset_m_per_radps (docs/method.md, "Calibrating the process noise").
 
     scripts/calibrate_noise.py DIR [DIR ...] [--offset A] [--window L] [--no-gain]
-                               [--no-lag | --drive-lag]
+                               [--no-lag | --drive-lag [--no-accel-limit]]
                                [--slip-by-regime | --slip-on-the-spot] [--turn-centre]
                                [--lag-noise] [--wheel-noise] [--ramp A_V A_W]
                                [--beyond DIR [DIR ...]] [--json FILE]
@@ -28,7 +28,8 @@ an arc along the mid-arc heading, plus a sideways skid):
   the gains by least squares at each tau; --no-lag keeps tau 0; --drive-lag
   fits the speed's lag with its change a step limited to a m/s^2 and the
   turn rate's own lag, slam.ekf.command_lag_s, command_max_accel_mps2 and
-  command_lag_w_s (departure 27), each DIR weighted alike: the cost is the
+  command_lag_w_s (departure 27; with --no-accel-limit the speed's lag
+  alone, the limit 0), each DIR weighted alike: the cost is the
   sum over the DIRs of log(mean e^2), so give one DIR per way of driving;
   fit_drive_lag; with --ramp A_V A_W, a robot that ramps its own set points
   toward the command at A_V m/s^2 and A_W rad/s^2, the lag follows the
@@ -389,7 +390,7 @@ def fit_lag(runs_steps, longest=0.5):
     return best if lag_cost(runs_steps, best) < lag_cost(runs_steps, 0.0) else 0.0
 
 
-def fit_drive_lag(groups, longest=0.5):
+def fit_drive_lag(groups, longest=0.5, limit=True):
     """(lag_v, lag_w, max_accel): the speed's lag with its acceleration limit
     and the turn rate's own lag (departure 27), each group of runs (one
     DIR: one way of driving) weighted alike (speed_cost). The turn rate's lag
@@ -397,8 +398,9 @@ def fit_drive_lag(groups, longest=0.5):
     in the limit above the largest change the commands ask for and steep
     below it, so the lag and limit are searched on a grid: the lag in steps
     of 5 ms up to 0.1 s, the limit from 0.2 to 5 m/s^2 in steps of 5 % and
-    none (0), then around the best on a grid five times finer. Each lag 0
-    where no lag fits better."""
+    none (0), then around the best on a grid five times finer; without
+    `limit` (--no-accel-limit) the limit is 0 and only the lag is searched.
+    Each lag 0 where no lag fits better."""
     def cost_w(lag_w):
         for runs_steps in groups:
             apply_lag(runs_steps, 0.0, lag_w)
@@ -417,7 +419,8 @@ def fit_drive_lag(groups, longest=0.5):
         return min((cost_v(t, a), t, a) for t in lags for a in limits)
 
     limits = [0.2 * 1.05 ** i for i in range(int(math.log(25.0) / math.log(1.05)) + 1)]
-    _, lag_v, max_accel = search([0.005 * i for i in range(21)], [0.0] + limits)
+    _, lag_v, max_accel = search([0.005 * i for i in range(21)],
+                                 [0.0] + limits if limit else [0.0])
     fine_lags = [max(0.0, lag_v + 0.001 * i) for i in range(-5, 6)]
     fine_limits = [0.0] if max_accel == 0.0 else [max_accel * 1.01 ** i for i in range(-5, 6)]
     _, lag_v, max_accel = search(fine_lags, fine_limits)
@@ -929,6 +932,9 @@ def main():
                      help="the speed's lag with its acceleration limit and the turn rate's own "
                           "lag (command_lag_s, command_max_accel_mps2, command_lag_w_s; "
                           "departure 27), each DIR weighted alike: one DIR per way of driving")
+    parser.add_argument("--no-accel-limit", action="store_true",
+                        help="with --drive-lag: the speed's lag alone, no acceleration limit "
+                             "(command_max_accel_mps2 0)")
     slip = parser.add_mutually_exclusive_group()
     slip.add_argument("--slip-by-regime", action="store_true",
                       help="fit the sideways slip per radian turned on the spot, its growth "
@@ -1008,6 +1014,9 @@ def main():
         return 2
     if args.ramp:
         apply_ramp(runs_steps, *args.ramp)
+    if args.no_accel_limit and not args.drive_lag:
+        print("calibrate_noise: --no-accel-limit needs --drive-lag", file=sys.stderr)
+        return 2
     if args.window < 1:
         print(f"calibrate_noise: --window: expected an integer >= 1 (got {args.window})",
               file=sys.stderr)
@@ -1019,7 +1028,7 @@ def main():
             count = len(run_dirs([path]))
             groups.append(runs_steps[start:start + count])
             start += count
-        lag, lag_w, max_accel = fit_drive_lag(groups)
+        lag, lag_w, max_accel = fit_drive_lag(groups, limit=not args.no_accel_limit)
         drive = (lag_w, max_accel)
     else:
         lag = 0.0 if args.no_lag else fit_lag(runs_steps)

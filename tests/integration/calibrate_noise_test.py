@@ -69,8 +69,10 @@ Case `drive` (--drive-lag, two DIRs): the robot's speed follows through a lag of
 change a step is limited to 0.8 m/s^2 (slam.ekf.command_max_accel_mps2), its turn rate through
 a lag of 0.07 s (command_lag_w_s); three runs of the steps above in one sweep directory and three
 of a ramp (0.05 m/s a row up to 0.4 m/s and down, no turn) in another. Asserted: the lags within
-0.005 s and the limit within 0.08 m/s^2 of their values; and, fitted without --drive-lag, the
-one lag more than 0.005 s off the speed's (the runs test the model).
+0.005 s and the limit within 0.08 m/s^2 of their values; fitted without --drive-lag, the
+one lag more than 0.005 s off the speed's (the runs test the model); with --no-accel-limit the
+limit 0 and the turn rate's lag still within 0.005 s of its own; --no-accel-limit without
+--drive-lag an error (exit status 2).
 
 Case `ramp` (--ramp 0.3 1.745): the robot of case `regime` whose controller ramps its set points
 toward each command at RAMP = (0.3 m/s^2, 1.745 rad/s^2) before the lag (slam.ekf.command_ramp_mps2,
@@ -412,6 +414,26 @@ def main(source_dir, case, extra):
             if abs(one["command_lag_s"] - DRIVE["tau"]) <= 0.005:
                 problems.append("without --drive-lag the one lag is still the speed's: the runs "
                                 "do not test the drive's model")
+            # Without the limit (--no-accel-limit): the limit 0, the turn
+            # rate's lag still its own; the option alone is an error.
+            lag_only = calibrate(source_dir, [steps_dir, ramps_dir],
+                                 ["--drive-lag", "--no-accel-limit"], fitted)
+            if lag_only is None:
+                return 1
+            print(f"--no-accel-limit: command_lag_s {lag_only['command_lag_s']:.4g}, "
+                  f"command_lag_w_s {lag_only['command_lag_w_s']:.4g}")
+            if lag_only["command_max_accel_mps2"] != 0.0:
+                problems.append("--no-accel-limit: the limit fitted "
+                                f"{lag_only['command_max_accel_mps2']}, expected 0")
+            if abs(lag_only["command_lag_w_s"] - DRIVE["tau_w"]) > 0.005:
+                problems.append(f"--no-accel-limit: command_lag_w_s {lag_only['command_lag_w_s']}"
+                                f", made {DRIVE['tau_w']}")
+            alone = subprocess.run(["/usr/bin/python3",
+                                    os.path.join(source_dir, "scripts", "calibrate_noise.py"),
+                                    steps_dir, "--no-accel-limit"], capture_output=True, text=True)
+            if alone.returncode != 2 or "--drive-lag" not in alone.stderr:
+                problems.append(f"--no-accel-limit without --drive-lag: expected exit status 2 "
+                                f"naming --drive-lag, got {alone.returncode}: {alone.stderr}")
         elif case == "ramp":
             ramp = ["--ramp", str(RAMP[0]), str(RAMP[1])]
             values = calibrate(source_dir, runs, REGIME + ramp + extra, fitted)
