@@ -2,10 +2,13 @@
 // small room (worlds/room.xml; the robot drives the first, straight leg of
 // the tour), through `mjslam sweep`, and the average pose NEES of each filter
 // against the two-sided 95 % chi-square bounds for 25 runs, 3 dof
-// ([2.118, 4.034]). Seeds 1..25 (run.seed = 1 plus the run index). And 10
-// closed-loop explorer runs of the default world, for the turns.
+// ([2.118, 4.034]). Seeds 1..25 (run.seed = 1 plus the run index). And
+// closed-loop explorer runs of the default world: 10 for the turns and the
+// innovations, four draws of 25 for the calibrated target.
 #include <cstdio>
 #include <filesystem>
+#include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -100,11 +103,12 @@ TEST(ConsistencyCheckTest, DetectsMeasurementNoiseUnderstatedTenTimes) {
 // The explorer's closed loop in the default world (the corridor loop), 10
 // runs, seeds 1..10, each until exploration ends (about 67 s): in the turns,
 // neither filter's average NEES may go above its upper bound (for the runs
-// still going at that step) for more than 5 % of the steps. Measured: 0.001
-// (classical) and 0 (selective) of 674 steps above, mean ANEES 2.28 and 2.26
-// (slightly underconfident). Without the skid in the prediction
-// (slam.ekf.lateral_skid_s=0, docs/method.md departure 13) the selective
-// filter is above for 0.108 of the steps.
+// still going at that step) for more than 5 % of the steps. Measured with
+// the calibrated default: 0.031 (classical) and 0.018 (selective) of 1470
+// steps above, mean ANEES 3.20 and 2.92. Without the skid in the prediction
+// (slam.ekf.lateral_skid_s=0, docs/method.md departure 13) both filters are
+// above for 0.83 of the steps (mean ANEES 45 and 35); with the conservative
+// noise before the calibration, 0.108 (selective).
 TEST(ClosedLoopConsistencyTest, NeitherFilterIsOverconfidentInTheExplorersTurns) {
   const nlohmann::json summary = SweepOf(
       "closed_loop", 10,
@@ -117,25 +121,19 @@ TEST(ClosedLoopConsistencyTest, NeitherFilterIsOverconfidentInTheExplorersTurns)
 }
 
 TEST(ClosedLoopConsistencyTest, CalibratedNoiseGivesConsistentInnovations) {
-  // configs/calibrated.yaml (the simulated drive disturbed by 1 % a step,
-  // wheel by wheel, and the command-following model and the process noise,
-  // with the settling wheels' term, the wheels' noise terms and the sideways
-  // slip on the spot, fitted to the robot's true motion by
-  // scripts/calibrate_noise.py on seeds 101-125 of that simulator), 10
-  // explorer runs of the default world, seeds 1 to 10. The mean over the runs
-  // of each run's mean NIS of the matched observations must lie in [1.6, 2.2]
-  // around the gate-truncated 2-dof chi-square mean 1.907 (measured 1.893
-  // classical, 1.901 selective; the fits before, with the twist disturbed:
-  // 1.889 / 1.918, and before the settling term: 1.729, 1.742). With the command noise of
-  // configs/default.yaml (conservative) it is 0.46 / 0.49 and the test
-  // fails. It does not see understated noise: with branch calib's noise
-  // fit and slip x 0.3 the mean NIS was 1.90 / 1.99 while the pose NEES was
-  // in the thousands (map and pose drift together; docs/results.md,
-  // "Calibrated process noise").
+  // The default config (the simulated drive disturbed by 1 % a step, wheel
+  // by wheel, and the process model fitted to that robot's true motion by
+  // scripts/calibrate_noise.py; configs/default.yaml's header), 10 explorer
+  // runs of the corridor loop, seeds 1 to 10. The mean over the runs of each
+  // run's mean NIS of the matched observations must lie in [1.6, 2.2] around
+  // the gate-truncated 2-dof chi-square mean 1.907 (docs/results.md,
+  // "Calibrated process noise", gives the figures measured). With the
+  // built-in conservative command noise (0.03 + 10 %, change 0.5) it was
+  // 0.46 / 0.49 and the test fails. It does not see understated noise: with
+  // an earlier fit and the slip x 0.3 the mean NIS was 1.90 / 1.99 while the
+  // pose NEES was in the thousands (map and pose drift together).
   const std::string dir = FreshDir("calibrated");
-  const nlohmann::json summary =
-      SweepOf("calibrated", 10, {"run.seed=1", "render.enabled=false"},
-              std::string(MJSLAM_SOURCE_DIR) + "/configs/calibrated.yaml");
+  const nlohmann::json summary = SweepOf("calibrated", 10, {"run.seed=1", "render.enabled=false"});
   for (const std::string f : {"classical", "selective"}) {
     double sum = 0.0;
     int runs = 0;
@@ -153,52 +151,72 @@ TEST(ClosedLoopConsistencyTest, CalibratedNoiseGivesConsistentInnovations) {
   }
 }
 
-// The target of calibrated noise: configs/calibrated.yaml (the drive
+// The target of calibrated noise with the default config (the drive
 // disturbed wheel by wheel, the process model fitted to that simulator's
-// true motion on seeds 101-125), 25 explorer runs of the corridor loop,
-// seeds 1-25, each until exploration ends: both filters' ANEES inside its
-// 95 % bounds for >= 90 % of the steps, and each pose component inside its
-// 2-sigma band for 91-98.5 % of the pooled steps (neither over- nor
-// underconfident). Measured: 0.959 / 0.954 of the steps inside (classical /
-// selective), 2 sigma 0.930-0.971 (seeds 26-50: 0.929 / 0.940). The same
-// runs with the command noise understated (x 0.3) fail it: see the next test.
-void ExpectCalibratedTarget(const nlohmann::json& summary, bool met) {
+// true motion on seeds 101-125): 25-run Monte Carlos of the explorer in the
+// corridor loop, each run until exploration ends, with both filters' ANEES
+// inside its 95 % bounds for >= 90 % of the steps and each pose component
+// inside its 2-sigma band for 91-98.5 % of the pooled steps (neither over-
+// nor underconfident). One draw of 25 runs spreads by about 0.03 around its
+// mean (docs/results.md, "Calibrated process noise": ten draws), so a model
+// at the target on average misses it on some draws. The test takes four
+// draws (seeds 1-25, 26-50, 51-75, 76-100): the mean of their fractions
+// inside the ANEES bounds >= 0.90 per filter, each draw >= 0.85, and every
+// draw's pooled 2-sigma fractions inside [0.91, 0.985]. The same runs with
+// the command noise understated (x 0.3) fail it: see the next test.
+struct DrawFigures {
+  double fraction_inside = 0.0;
+  bool components_ok = true;
+};
+
+DrawFigures FiguresOf(const nlohmann::json& summary, const std::string& f) {
   EXPECT_GE(summary["sweep"]["steps"].get<int>(), 500);
-  for (const std::string f : {"classical", "selective"}) {
-    const nlohmann::json& s = summary["filters"][f];
-    const nlohmann::json& inside = s["inside_2sigma_pooled"];
-    std::printf("%s: 2 sigma x %.3f y %.3f th %.3f\n", f.c_str(), inside["x"].get<double>(),
-                inside["y"].get<double>(), inside["th"].get<double>());
-    bool component_ok = true;
-    for (const std::string c : {"x", "y", "th"}) {
-      component_ok &= inside[c].get<double>() >= 0.91 && inside[c].get<double>() <= 0.985;
-    }
-    const bool anees_ok = s["fraction_inside"].get<double>() >= 0.90;
-    if (met) {
-      EXPECT_TRUE(anees_ok) << f << ": ANEES inside for " << s["fraction_inside"];
-      EXPECT_TRUE(component_ok) << f << ": " << inside;
-    } else {
-      EXPECT_FALSE(anees_ok && component_ok) << f << " meets the target with understated noise";
-    }
+  const nlohmann::json& s = summary["filters"][f];
+  const nlohmann::json& inside = s["inside_2sigma_pooled"];
+  std::printf("%s: ANEES inside %.3f, 2 sigma x %.3f y %.3f th %.3f\n", f.c_str(),
+              s["fraction_inside"].get<double>(), inside["x"].get<double>(),
+              inside["y"].get<double>(), inside["th"].get<double>());
+  DrawFigures figures;
+  figures.fraction_inside = s["fraction_inside"].get<double>();
+  for (const std::string c : {"x", "y", "th"}) {
+    figures.components_ok &= inside[c].get<double>() >= 0.91 && inside[c].get<double>() <= 0.985;
   }
+  return figures;
 }
 
 TEST(CalibratedMonteCarloTest, BothFiltersAreConsistentInTheCorridor) {
-  ExpectCalibratedTarget(SweepOf("calibrated_target", kRuns, {"run.seed=1", "render.enabled=false"},
-                                 std::string(MJSLAM_SOURCE_DIR) + "/configs/calibrated.yaml"),
-                         true);
+  std::vector<nlohmann::json> draws;
+  for (const int seed : {1, 26, 51, 76}) {
+    draws.push_back(SweepOf("calibrated_target_" + std::to_string(seed), kRuns,
+                            {"run.seed=" + std::to_string(seed), "render.enabled=false"}));
+  }
+  for (const std::string f : {"classical", "selective"}) {
+    double sum = 0.0;
+    for (const nlohmann::json& draw : draws) {
+      const DrawFigures figures = FiguresOf(draw, f);
+      sum += figures.fraction_inside;
+      EXPECT_GE(figures.fraction_inside, 0.85) << f;
+      EXPECT_TRUE(figures.components_ok) << f;
+    }
+    const double mean = sum / static_cast<double>(draws.size());
+    std::printf("%s: ANEES inside over the four draws: mean %.3f\n", f.c_str(), mean);
+    EXPECT_GE(mean, 0.90) << f;
+  }
 }
 
-// The check can fail: the command noise understated (both factors 0.3).
-// Measured: ANEES inside for none of the steps, above for all (mean ANEES in
-// the thousands: the maps break).
+// The check can fail: the command noise understated (both factors 0.3), one
+// draw. Measured: ANEES inside for none of the steps, above for all (mean
+// ANEES in the thousands: the maps break).
 TEST(CalibratedMonteCarloTest, UnderstatedNoiseMissesTheTarget) {
-  ExpectCalibratedTarget(
+  const nlohmann::json summary =
       SweepOf("calibrated_understated", kRuns,
               {"run.seed=1", "render.enabled=false", "slam.ekf.command_noise.v_noise_scale=0.3",
-               "slam.ekf.command_noise.w_noise_scale=0.3"},
-              std::string(MJSLAM_SOURCE_DIR) + "/configs/calibrated.yaml"),
-      false);
+               "slam.ekf.command_noise.w_noise_scale=0.3"});
+  for (const std::string f : {"classical", "selective"}) {
+    const DrawFigures figures = FiguresOf(summary, f);
+    EXPECT_FALSE(figures.fraction_inside >= 0.85 && figures.components_ok)
+        << f << " meets the target with understated noise";
+  }
 }
 
 }  // namespace
