@@ -94,12 +94,14 @@ an arc along the mid-arc heading, plus a sideways skid):
   calibrated_change_v_mps and _w_radps: the model above holds for them; a
   larger step meets the drive's torque limit. Beyond it the noise grows by
   f c_v x in sigma_v and f c_w x in sigma_w, x the relative excess of a
-  change and of the one a record earlier (CommandInput, departure 29), with
-  f = beyond_change_noise_fraction written as 1 (BEYOND_BOUND: the excess
-  itself one standard deviation). With --beyond DIR [DIR ...], runs that go
-  beyond the range (a larger world, where the filters take longer and the
-  explorer's steps grow), f's maximum likelihood value over their steps
-  beyond, everything else held, is printed for comparison
+  change and of the one a record earlier (CommandInput, departure 29); f
+  (beyond_change_noise_fraction) is not written: it is set by the filters'
+  consistency on training runs that go beyond the range (docs/method.md,
+  "Calibrating the process noise", step 5), because the maximum likelihood
+  value fits the typical step beyond and not the tail the filters lose
+  their map on. With --beyond DIR [DIR ...], such runs (a larger world,
+  where the filters take longer and the explorer's steps grow), that value
+  over their steps beyond, everything else held, is printed
   (fit_beyond_change).
 
 Prints the fitted values as the YAML of configs/default.yaml's slam.ekf
@@ -517,15 +519,6 @@ def fit_command(runs_steps, window, with_gains=True, rounds=3, lag_noise=False,
     return full(p), gains
 
 
-# beyond_change_noise_fraction written: the excess of a change over the
-# calibrated range taken as one standard deviation of the speed's error (the
-# robot may not follow that part at all within the step). A bound, not a fit:
-# the maximum likelihood value over the steps beyond (--beyond) fits the
-# typical one, and the filters lose the map at a single 3-sigma step there
-# (docs/results.md, "Calibrated process noise").
-BEYOND_BOUND = 1.0
-
-
 def change_range(steps):
     """(c_v, c_w): the largest changes of the commanded speed and turn rate
     from one record to the next among `steps`, the range a fit of them covers
@@ -769,11 +762,18 @@ ODOMETRY_NAMES = ["distance_noise_std_m", "distance_noise_std_m_per_sqrt_m",
                   "heading_noise_std_rad_per_sqrt_rad"]
 
 
+# A fitted constant below this is written as 0: the fit ran it off toward 0
+# (fit works on logarithms), and 1e-308 in a config reads as a value.
+NEGLIGIBLE = 1e-12
+
+
 def command_noise(command, lag_noise):
     """The fitted constants of fit_command's `command` as the keys of
     slam.ekf.command_noise: lag_noise_fraction only when fitted (`lag_noise`;
-    fit_command holds it at 0 before the wheels' terms otherwise)."""
-    return {name: value for name, value in zip(COMMAND_NAMES, command)
+    fit_command holds it at 0 before the wheels' terms otherwise); those
+    below NEGLIGIBLE as 0."""
+    return {name: value if value >= NEGLIGIBLE else 0.0
+            for name, value in zip(COMMAND_NAMES, command)
             if name != "lag_noise_fraction" or lag_noise}
 
 
@@ -1080,8 +1080,8 @@ def main():
         print(f"      {name}: {value:.4g}")
     print(f"      calibrated_change_v_mps: {c_v:.4g}   # the largest changes fitted")
     print(f"      calibrated_change_w_radps: {c_w:.4g}")
-    print(f"      beyond_change_noise_fraction: {BEYOND_BOUND:g}   # the bound: the excess as "
-          f"one standard deviation")
+    print("      # beyond_change_noise_fraction: set on training runs beyond the range "
+          "(docs/method.md)")
     if beyond:
         print(f"# --beyond: {beyond[1]} of {beyond[2]} steps beyond the range; maximum "
               f"likelihood fraction there {beyond[0]:.4g} (the typical step, not the tail)")
@@ -1169,8 +1169,7 @@ def main():
                   **ekf_values(gains, lag, command, odometry, c, k, args.lag_noise)}
         if drive:
             values.update(command_lag_w_s=drive[0], command_max_accel_mps2=drive[1])
-        values["command_noise"].update(calibrated_change_v_mps=c_v, calibrated_change_w_radps=c_w,
-                                       beyond_change_noise_fraction=BEYOND_BOUND)
+        values["command_noise"].update(calibrated_change_v_mps=c_v, calibrated_change_w_radps=c_w)
         if beyond:
             values.update(beyond_change_ml_fraction=beyond[0], beyond_steps=beyond[1])
         if args.ramp:
