@@ -1005,6 +1005,9 @@ def main():
         print("calibrate_noise: expected a run or sweep directory (or --consistency)",
               file=sys.stderr)
         return 2
+    if args.no_accel_limit and not args.drive_lag:
+        print("calibrate_noise: --no-accel-limit needs --drive-lag", file=sys.stderr)
+        return 2
 
     try:
         runs = run_dirs(args.dirs)
@@ -1014,9 +1017,6 @@ def main():
         return 2
     if args.ramp:
         apply_ramp(runs_steps, *args.ramp)
-    if args.no_accel_limit and not args.drive_lag:
-        print("calibrate_noise: --no-accel-limit needs --drive-lag", file=sys.stderr)
-        return 2
     if args.window < 1:
         print(f"calibrate_noise: --window: expected an integer >= 1 (got {args.window})",
               file=sys.stderr)

@@ -241,6 +241,18 @@ def calibrate(source_dir, runs, options, fitted):
         return json.load(f)
 
 
+def usage_error(source_dir, arguments, names):
+    """The problem, if any, of calibrate_noise.py with `arguments` not ending
+    with exit status 2 and a message naming every one of `names`."""
+    result = subprocess.run(["/usr/bin/python3",
+                             os.path.join(source_dir, "scripts", "calibrate_noise.py"),
+                             *arguments], capture_output=True, text=True)
+    if result.returncode == 2 and all(name in result.stderr for name in names):
+        return []
+    return [f"{' '.join(arguments[-2:])}: expected exit status 2 naming {', '.join(names)}, "
+            f"got {result.returncode}: {result.stderr}"]
+
+
 def value(values, key):
     """A fitted value of slam.ekf (0 when not fitted)."""
     return values.get(key, values["command_noise"].get(key, 0.0))
@@ -353,14 +365,8 @@ def main(source_dir, case, extra):
             if values["lateral_slip_std_m_per_rad_per_mps"] != 0.0:
                 problems.append("lateral_slip_std_m_per_rad_per_mps: fitted "
                                 f"{values['lateral_slip_std_m_per_rad_per_mps']}, expected 0")
-            both = subprocess.run(["/usr/bin/python3",
-                                   os.path.join(source_dir, "scripts", "calibrate_noise.py"),
-                                   *runs, "--slip-on-the-spot", "--slip-by-regime"],
-                                  capture_output=True, text=True)
-            if (both.returncode != 2 or "--slip-on-the-spot" not in both.stderr
-                    or "--slip-by-regime" not in both.stderr):
-                problems.append("--slip-on-the-spot with --slip-by-regime: expected exit status "
-                                f"2 naming both, got {both.returncode}: {both.stderr}")
+            problems += usage_error(source_dir, [*runs, "--slip-on-the-spot", "--slip-by-regime"],
+                                    ["--slip-on-the-spot", "--slip-by-regime"])
         elif case == "straight":
             # Runs that never turn leave the turn-rate terms nothing to fit:
             # they run off to 0, and the fit must still end with the gain and
@@ -429,12 +435,7 @@ def main(source_dir, case, extra):
             if abs(lag_only["command_lag_w_s"] - DRIVE["tau_w"]) > 0.005:
                 problems.append(f"--no-accel-limit: command_lag_w_s {lag_only['command_lag_w_s']}"
                                 f", made {DRIVE['tau_w']}")
-            alone = subprocess.run(["/usr/bin/python3",
-                                    os.path.join(source_dir, "scripts", "calibrate_noise.py"),
-                                    steps_dir, "--no-accel-limit"], capture_output=True, text=True)
-            if alone.returncode != 2 or "--drive-lag" not in alone.stderr:
-                problems.append(f"--no-accel-limit without --drive-lag: expected exit status 2 "
-                                f"naming --drive-lag, got {alone.returncode}: {alone.stderr}")
+            problems += usage_error(source_dir, [steps_dir, "--no-accel-limit"], ["--drive-lag"])
         elif case == "ramp":
             ramp = ["--ramp", str(RAMP[0]), str(RAMP[1])]
             values = calibrate(source_dir, runs, REGIME + ramp + extra, fitted)
@@ -472,12 +473,7 @@ def main(source_dir, case, extra):
                 problems.append("beyond_change_noise_fraction written: it is set on training "
                                 "runs, not fitted")
             # Runs that never go beyond leave nothing to fit: an error.
-            none = subprocess.run(["/usr/bin/python3",
-                                   os.path.join(source_dir, "scripts", "calibrate_noise.py"),
-                                   *runs, "--beyond", *runs], capture_output=True, text=True)
-            if none.returncode != 2 or "--beyond" not in none.stderr:
-                problems.append(f"--beyond without a change beyond: expected exit status 2 "
-                                f"naming --beyond, got {none.returncode}: {none.stderr}")
+            problems += usage_error(source_dir, [*runs, "--beyond", *runs], ["--beyond"])
         else:
             print(f"unknown case {case!r}: expected regime, wheels, spot, straight, drive, "
                   "ramp or beyond")

@@ -53,7 +53,8 @@ TEST(MapLossRunTest, CopyTestReportsTheMazeMapLossAndIsQuietWithTheRule) {
     EXPECT_EQ(check["verdict"], "inconsistent") << f;
   }
   for (const std::string& config : {Conservative(), testing::DefaultConfig()}) {
-    const nlohmann::json kept = MazeRun("default_rule", "--config " + config);
+    const nlohmann::json kept =
+        MazeRun(config == Conservative() ? "default_rule" : "calibrated", "--config " + config);
     for (const char* f : {"classical", "selective"}) {
       const nlohmann::json& check = kept["filters"][f]["innovation_check"];
       EXPECT_TRUE(check["map_copied_at_s"].is_null()) << config << " " << f << " " << check.dump();
