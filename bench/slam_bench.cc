@@ -172,7 +172,7 @@ void BM_DenseCorrectionReference(benchmark::State& state) {
   const SlamState::Measurement m = slam.Measure(k);
   Eigen::MatrixXd H = Eigen::MatrixXd::Zero(2, n);
   H.leftCols<3>() = m.H_pose;
-  H.middleCols<2>(SlamState::FeatureIndex(k)) = m.H_feature;
+  H.middleCols<2>(slam.FeatureIndex(k)) = m.H_feature;
   const Eigen::Matrix2d R = Eigen::Vector2d(1e-4, 1e-5).asDiagonal();
   const Eigen::MatrixXd P = slam.covariance();
   Eigen::MatrixXd P_new(n, n);

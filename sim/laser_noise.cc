@@ -13,6 +13,11 @@ LaserNoise::LaserNoise(const LaserParams& laser, const Rng& run_rng)
       range_rng_(run_rng.Fork("laser.range")),
       dropout_rng_(run_rng.Fork("laser.dropout")) {
   laser_.ValidateOrThrow();
+  // The run's systematic errors: drawn once, always (bias, then scale).
+  Rng calibration_rng = run_rng.Fork("laser.calibration");
+  range_bias_m_ = calibration_rng.Gaussian(laser_.range_bias_m, laser_.range_bias_std_m);
+  range_scale_ =
+      1.0 + calibration_rng.Gaussian(laser_.range_scale_fraction, laser_.range_scale_std_fraction);
 }
 
 std::vector<double> LaserNoise::DrawAngleOffsets() {
@@ -31,7 +36,7 @@ LaserScan LaserNoise::Apply(const LaserScan& exact) {
   const double max_range = laser_.max_range_m;
   for (int i = 0; i < exact.size(); ++i) {
     // Draw both numbers for every beam, so beams never shift each other's noise.
-    const double error = range_rng_.Gaussian(laser_.range_bias_m, laser_.range_noise_std_m);
+    const double error = range_rng_.Gaussian(range_bias_m_, laser_.range_noise_std_m);
     const bool dropped = dropout_rng_.Bernoulli(laser_.dropout_probability);
     if (!exact.has_return[i]) continue;
     if (dropped) {
@@ -42,7 +47,7 @@ LaserScan LaserNoise::Apply(const LaserScan& exact) {
     // An echo is a range strictly below the maximum: noise that carries a
     // range to the maximum or beyond turns it into a no-return, as on the
     // SICK, so a recorded scan says the same thing without its flags.
-    const double range = std::max(exact.ranges_m[i] + error, 0.0);
+    const double range = std::max(exact.ranges_m[i] * range_scale_ + error, 0.0);
     if (range >= max_range) {
       noisy.ranges_m[i] = max_range;
       noisy.has_return[i] = 0;

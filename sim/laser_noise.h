@@ -16,8 +16,11 @@ namespace mjslam::sim {
 /// - "laser.jitter": angular jitter, N(0, angle_jitter_std_deg). The beam is
 ///   actually cast at nominal + offset (DrawAngleOffsets, passed to
 ///   Simulator::CastLaser) but reported at its nominal angle.
-/// - "laser.range": range noise, N(range_bias_m, range_noise_std_m), added to
-///   every beam that has an echo.
+/// - "laser.calibration": the run's systematic errors, drawn once: the bias
+///   b ~ N(range_bias_m, range_bias_std_m) and the scale error s ~
+///   N(range_scale_fraction, range_scale_std_fraction);
+/// - "laser.range": range noise: every beam that has an echo reads
+///   range (1 + s) + N(b, range_noise_std_m).
 /// - "laser.dropout": with dropout_probability the echo is lost: the beam
 ///   becomes a no-return at max range.
 /// Ranges are clamped to [0, max_range_m]; a beam with an echo keeps it even
@@ -47,6 +50,8 @@ class LaserNoise {
 
  private:
   LaserParams laser_;
+  double range_bias_m_ = 0.0;
+  double range_scale_ = 1.0;
   Rng jitter_rng_;
   Rng range_rng_;
   Rng dropout_rng_;

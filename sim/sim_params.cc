@@ -48,6 +48,9 @@ std::vector<ParamProblem> LaserParams::Validate() const {
   check.Require(range_bias_m > -max_range_m && range_bias_m < max_range_m,
                 "range_bias_m", range_bias_m,
                 "a value in (-max_range_m, max_range_m)");
+  check.InRange("range_bias_std_m", range_bias_std_m, 0.0, 1.0);
+  check.InRange("range_scale_fraction", range_scale_fraction, -0.2, 0.2);
+  check.InRange("range_scale_std_fraction", range_scale_std_fraction, 0.0, 0.2);
   check.NonNegative("angle_jitter_std_deg", angle_jitter_std_deg);
   check.InRange("dropout_probability", dropout_probability, 0.0, 1.0);
   return check.problems();
@@ -59,6 +62,13 @@ std::vector<ParamProblem> OdometryParams::Validate() const {
   check.NonNegative("slip_std_fraction", slip_std_fraction);
   check.InRange("wheel_radius_error_std_fraction", wheel_radius_error_std_fraction,
                 0.0, 0.2);
+  check.InRange("left_wheel_radius_error_fraction", left_wheel_radius_error_fraction, -0.2, 0.2);
+  check.InRange("right_wheel_radius_error_fraction", right_wheel_radius_error_fraction, -0.2,
+                0.2);
+  check.InRange("axle_track_error_std_fraction", axle_track_error_std_fraction, 0.0, 0.2);
+  check.InRange("axle_track_error_fraction", axle_track_error_fraction, -0.2, 0.2);
+  check.InRange("correlated_slip_std_fraction", correlated_slip_std_fraction, 0.0, 0.2);
+  check.Positive("slip_correlation_distance_m", slip_correlation_distance_m);
   return check.problems();
 }
 

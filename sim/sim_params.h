@@ -122,8 +122,16 @@ struct LaserParams {
   /// `slam.features.range_noise_std_m` (same default); they differ only when
   /// set apart on purpose, and `mjslam run` prints a note when they do.
   double range_noise_std_m = 0.005;
-  /// Constant range bias added to every echo, metres.
+  /// Systematic range error of every echo: range (1 + s) + b, with the bias
+  /// b drawn once per run from N(range_bias_m, range_bias_std_m) and the
+  /// scale error s from N(range_scale_fraction, range_scale_std_fraction)
+  /// (stream "laser.calibration"). A SICK LMS200's systematic error is of
+  /// the order of +-15 mm (its data sheet's "systematic error", Ye and
+  /// Borenstein, ICRA 2002). Metres; fraction.
   double range_bias_m = 0.0;
+  double range_bias_std_m = 0.0;
+  double range_scale_fraction = 0.0;
+  double range_scale_std_fraction = 0.0;
   /// Standard deviation of the per-beam angular jitter, degrees: the beam is
   /// cast at its nominal angle plus this error, but reported at the nominal one.
   double angle_jitter_std_deg = 0.0;
@@ -143,6 +151,9 @@ struct LaserParams {
     a->Visit(MJSLAM_NVP(rate_hz));
     a->Visit(MJSLAM_NVP(range_noise_std_m));
     a->Visit(MJSLAM_NVP(range_bias_m));
+    a->Visit(MJSLAM_NVP(range_bias_std_m));
+    a->Visit(MJSLAM_NVP(range_scale_fraction));
+    a->Visit(MJSLAM_NVP(range_scale_std_fraction));
     a->Visit(MJSLAM_NVP(angle_jitter_std_deg));
     a->Visit(MJSLAM_NVP(dropout_probability));
   }
@@ -160,14 +171,37 @@ struct OdometryParams {
   /// the distance rolled, so the result does not depend on the update rate.
   double slip_std_fraction = 0.005;
   /// Systematic error: each wheel's effective radius differs from the nominal
-  /// one by a factor 1 + e, e drawn once per run from N(0, this).
+  /// one by a factor 1 + e, e drawn once per run from N(mean, this) with the
+  /// wheel's mean below (left, then right).
   double wheel_radius_error_std_fraction = 0.0;
+  /// Mean of the left and right wheels' radius errors, fractions: a fixed
+  /// error the same in every run (e.g. a worn tyre), 0 by default.
+  double left_wheel_radius_error_fraction = 0.0;
+  double right_wheel_radius_error_fraction = 0.0;
+  /// Systematic error of the axle track: the wheels' contact points are
+  /// b (1 + e) apart while the odometry assumes b (RobotParams::axle_track_m),
+  /// e drawn once per run from N(axle_track_error_fraction, this).
+  double axle_track_error_std_fraction = 0.0;
+  double axle_track_error_fraction = 0.0;
+  /// Slip correlated in time: each wheel's travel is also off by a fraction
+  /// that wanders as a first-order Gauss-Markov process over the distance the
+  /// wheel rolls (stationary standard deviation this, correlation length
+  /// `slip_correlation_distance_m`): a patch of floor, a tyre's load in a
+  /// long turn. 0: none.
+  double correlated_slip_std_fraction = 0.0;
+  double slip_correlation_distance_m = 1.0;
 
   template <typename Archive>
   void Serialize(Archive* a) {
     a->Visit(MJSLAM_NVP(ticks_per_wheel_revolution));
     a->Visit(MJSLAM_NVP(slip_std_fraction));
     a->Visit(MJSLAM_NVP(wheel_radius_error_std_fraction));
+    a->Visit(MJSLAM_NVP(left_wheel_radius_error_fraction));
+    a->Visit(MJSLAM_NVP(right_wheel_radius_error_fraction));
+    a->Visit(MJSLAM_NVP(axle_track_error_std_fraction));
+    a->Visit(MJSLAM_NVP(axle_track_error_fraction));
+    a->Visit(MJSLAM_NVP(correlated_slip_std_fraction));
+    a->Visit(MJSLAM_NVP(slip_correlation_distance_m));
   }
   std::vector<ParamProblem> Validate() const;
   void ValidateOrThrow() const { ThrowIfProblems(Validate()); }

@@ -33,12 +33,13 @@ Eigen::Matrix<double, 5, 5> SelectionBlock(const Eigen::Matrix<double, 5, 5>& P_
 
 double SelectionCriterion(const SlamState& state, const MatchedObservation& observation) {
   return SelectionCriterion(
-      state.InnovationCovariance(observation.feature, observation.z, observation.R),
+      state.InnovationCovariance(observation.feature, observation.z, observation.R,
+                                 observation.range_bias_gradient),
       observation.R);
 }
 
 double PoseDeterminantAfter(const SlamState& state, const MatchedObservation& observation) {
-  const SlamState::Measurement m = state.MeasureFor(observation.feature, observation.z);
+  const SlamState::Measurement m = state.MeasureFor(observation.feature, observation.z, observation.range_bias_gradient);
   MJSLAM_CHECK(m.valid);
   Eigen::Matrix<double, 2, 5> H_b;
   H_b << m.H_pose, m.H_feature;
@@ -51,7 +52,8 @@ double PoseDeterminantAfter(const SlamState& state, const MatchedObservation& ob
 
 int CorrectClassical(SlamState* state, const std::vector<MatchedObservation>& matched) {
   for (const MatchedObservation& observation : matched) {
-    state->Update(observation.feature, observation.z, observation.R);
+    state->Update(observation.feature, observation.z, observation.R,
+                  observation.range_bias_gradient);
   }
   return static_cast<int>(matched.size());
 }
@@ -105,7 +107,7 @@ std::vector<int> CorrectSelective(SlamState* state, const std::vector<MatchedObs
 
     // Correct with it (as in Algorithm 1) and drop it from the candidates.
     const MatchedObservation& chosen = matched[remaining[best]];
-    state->Update(chosen.feature, chosen.z, chosen.R);
+    state->Update(chosen.feature, chosen.z, chosen.R, chosen.range_bias_gradient);
     used.push_back(remaining[best]);
     remaining.erase(remaining.begin() + best);
   }

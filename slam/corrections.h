@@ -19,6 +19,9 @@ struct MatchedObservation {
   Eigen::Vector2d z = Eigen::Vector2d::Zero();
   /// Its covariance R (2x2 SPD).
   Eigen::Matrix2d R = Eigen::Matrix2d::Identity();
+  /// d z / d (laser range bias), in z's form (LineObservation's or
+  /// CornerObservation's range_bias_gradient); used with self-calibration.
+  Eigen::Vector2d range_bias_gradient = Eigen::Vector2d::Zero();
 };
 
 /// The paper's selection criterion for one candidate, sum(eig(B_i)) with

@@ -55,6 +55,16 @@ void RequireFinite(double value, const std::string& what) {
   }
 }
 
+// The prior standard deviations of the self-calibration entries, in the
+// state's order; empty when self-calibration is off.
+Eigen::VectorXd CalibrationStd(const SelfCalibrationParams& calibration) {
+  if (!calibration.Enabled()) return Eigen::VectorXd();
+  Eigen::VectorXd std(SlamState::kCalibrationSize);
+  std << calibration.distance_scale_std, calibration.heading_scale_std,
+      calibration.heading_per_m_std_rad, calibration.range_bias_std_m, calibration.range_scale_std;
+  return std;
+}
+
 }  // namespace
 
 EkfSlam::EkfSlam(const EkfParams& params, CorrectionMode mode, const Pose2& X_WR0,
@@ -69,7 +79,7 @@ EkfSlam::EkfSlam(const EkfParams& params, CorrectionMode mode, const Pose2& X_WR
                              params.initial_position_std_m * params.initial_position_std_m,
                              params.initial_heading_std_rad * params.initial_heading_std_rad)
                  .asDiagonal(),
-             X_RS, JacobianPointFromName(params.jacobians)),
+             X_RS, JacobianPointFromName(params.jacobians), CalibrationStd(params.self_calibration)),
       gate_(ChiSquare2Quantile(params.gate_probability)),
       new_feature_threshold_(ChiSquare2Quantile(params.new_feature_probability)) {
   if (!IsFinite(X_WR0)) {
@@ -109,6 +119,7 @@ std::vector<EkfSlam::Observation> EkfSlam::CollectObservations(
     observation.z = CanonicalLine(Eigen::Vector2d(line.rho_m, line.alpha_rad), &J);
     observation.R = J * CheckedCovariance(line.covariance + extra_line, what + ".covariance") *
                     J.transpose();
+    observation.range_bias_gradient = J * line.range_bias_gradient;
     observation.p_SA = line.p_SA;
     observation.p_SB = line.p_SB;
     observations.push_back(observation);
@@ -131,6 +142,7 @@ std::vector<EkfSlam::Observation> EkfSlam::CollectObservations(
     observation.type = FeatureType::kCorner;
     observation.z = Eigen::Vector2d(corner.range_m, WrapAngleFast(corner.bearing_rad));
     observation.R = CheckedCovariance(corner.covariance + extra_corner, what + ".covariance");
+    observation.range_bias_gradient = corner.range_bias_gradient;
     observation.p_SA = corner.p_SC;
     observation.p_SB = corner.p_SC;
     observations.push_back(observation);
@@ -152,8 +164,7 @@ Eigen::MatrixXd EkfSlam::MahalanobisDistances(const std::vector<Observation>& ob
       if (observation.type != state_.feature_type(k)) continue;
       if (observation.type == FeatureType::kLine && !SegmentsMeet(k, observation, X_WS)) continue;
       // A line's prediction in the observation's polar form.
-      Eigen::Vector2d h = m.h;
-      Eigen::Matrix2d HPHt = m.HPHt;
+      SlamState::Measurement mo = m;
       if (observation.type == FeatureType::kLine) {
         // A wall's face is seen from its front only: with the sensor
         // clearly on the other side of the line than when the feature was
@@ -161,13 +172,13 @@ Eigen::MatrixXd EkfSlam::MahalanobisDistances(const std::vector<Observation>& ob
         // wall, 0.15 m away), not of this one (docs/method.md, departure 5).
         if (params_.gate_line_side && info_[k].seen_side != 0) {
           const double side = SensorSideOfLine(k);
-          const double margin = 3.0 * std::sqrt(HPHt(0, 0) + observation.R(0, 0));
+          const double margin = 3.0 * std::sqrt(mo.HPHt(0, 0) + observation.R(0, 0));
           if (side * info_[k].seen_side < 0.0 && std::abs(side) > margin) continue;
         }
-        AlignLineToObservation(observation.z, &h, nullptr, nullptr, &HPHt);
       }
-      const Eigen::Vector2d nu = Innovation(observation.z, h);
-      const Eigen::Matrix2d S = HPHt + observation.R;
+      state_.ToObservation(observation.type, observation.z, observation.range_bias_gradient, &mo);
+      const Eigen::Vector2d nu = Innovation(observation.z, mo.h);
+      const Eigen::Matrix2d S = mo.HPHt + observation.R;
       // nu^T S^-1 nu with the 2x2 inverse written out.
       const double det = S(0, 0) * S(1, 1) - S(0, 1) * S(1, 0);
       d2(i, k) = (S(1, 1) * nu.x() * nu.x() - (S(0, 1) + S(1, 0)) * nu.x() * nu.y() +
@@ -293,7 +304,8 @@ std::vector<MatchedObservation> EkfSlam::SelectMatches(
           continue;
         }
       }
-      matched.push_back({association.feature[i], observations[i].z, observations[i].R});
+      matched.push_back({association.feature[i], observations[i].z, observations[i].R,
+                         observations[i].range_bias_gradient});
       matched_observation->push_back(i);
     } else if (association.outcome[i] == AssociationOutcome::kNew) {
       ++report->num_new;
@@ -330,7 +342,10 @@ void EkfSlam::AddNewFeatures(const Association& association,
         ++report->num_corners_from_lines;
       }
     }
-    if (k < 0) k = state_.AddFeature(observation.type, observation.z, observation.R);
+    if (k < 0) {
+      k = state_.AddFeature(observation.type, observation.z, observation.R,
+                            observation.range_bias_gradient);
+    }
     if (i < num_lines) line_feature[i] = k;
     info_.push_back({next_id_++, LineSegment{}});
     if (observation.type == FeatureType::kLine) {

@@ -130,6 +130,8 @@ class EkfSlam {
     FeatureType type;
     Eigen::Vector2d z;
     Eigen::Matrix2d R;
+    // d z / d (laser range bias), in z's form.
+    Eigen::Vector2d range_bias_gradient;
     // Seen endpoints in S (lines only).
     Eigen::Vector2d p_SA;
     Eigen::Vector2d p_SB;

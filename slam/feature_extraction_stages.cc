@@ -251,11 +251,34 @@ bool ShouldTrim(const std::vector<ScanPoint>& points, const Segment& segment,
 }
 
 // The line observation of a final segment, with the model-error floor.
+// d (rho, alpha) / d b of the fit of `segment` when every range is off by b.
+// A point's residual d_i = r_i cos(phi_i - alpha) - rho grows by b c_i,
+// c_i = cos(phi_i - alpha); the weighted fit absorbs it through the gradient
+// (-1, t_i) of d_i in (rho, alpha) (FitLine), so to first order
+//   d (rho, alpha) / d b = Cov sum w_i c_i (1, -t_i),
+// Cov the fit's covariance (the inverse of sum w_i (-1, t_i)^T (-1, t_i)),
+// w_i its weights at the fitted angle.
+Eigen::Vector2d RangeBiasGradient(const std::vector<ScanPoint>& points, const Segment& segment,
+                                  const NoiseModel& noise) {
+  const LineFit& fit = segment.fit;
+  Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+  for (int i = segment.first; i <= segment.last; ++i) {
+    const ScanPoint& p = points[i];
+    const double w = 1.0 / PerpendicularVariance(p, fit.cos_alpha, fit.sin_alpha, noise);
+    const double along_normal = p.x * fit.cos_alpha + p.y * fit.sin_alpha;
+    const double along_line = -p.x * fit.sin_alpha + p.y * fit.cos_alpha;
+    const double c = along_normal / p.range;
+    sum += w * c * Eigen::Vector2d(1.0, -along_line);
+  }
+  return fit.covariance * sum;
+}
+
 LineObservation MakeLine(const std::vector<ScanPoint>& points, const Segment& segment,
-                         const Eigen::Matrix2d& floor) {
+                         const Eigen::Matrix2d& floor, const NoiseModel& noise) {
   LineObservation line;
   line.rho_m = segment.fit.rho;
   line.alpha_rad = segment.fit.alpha;
+  line.range_bias_gradient = RangeBiasGradient(points, segment, noise);
   const Eigen::Matrix2d covariance = segment.fit.covariance + floor;
   line.covariance = 0.5 * (covariance + covariance.transpose());
   line.p_SA = ProjectOntoLine(segment.fit, points[segment.first]);
@@ -523,12 +546,13 @@ std::vector<LineObservation> KeepLines(const std::vector<ScanPoint>& points,
   Eigen::Matrix2d floor = Eigen::Matrix2d::Zero();
   floor(0, 0) = rho_floor * rho_floor + kCovarianceFloor;
   floor(1, 1) = alpha_floor * alpha_floor + kCovarianceFloor;
+  const NoiseModel noise = MakeNoiseModel(params);
   line_of_run->assign(runs.size(), -1);
   std::vector<LineObservation> lines;
   lines.reserve(runs.size());
   for (std::size_t i = 0; i < runs.size(); ++i) {
     if (!runs[i].valid) continue;
-    LineObservation line = MakeLine(points, runs[i], floor);
+    LineObservation line = MakeLine(points, runs[i], floor, noise);
     if ((line.p_SB - line.p_SA).norm() < params.min_length_m) {
       runs[i].valid = false;
       continue;
@@ -613,6 +637,9 @@ std::optional<CornerObservation> CornerBetween(const std::vector<ScanPoint>& poi
   corner.range_m = range_bearing.x();
   corner.bearing_rad = range_bearing.y();
   corner.covariance = covariance;
+  Eigen::Vector4d lines_bias_gradient;
+  lines_bias_gradient << line_a.range_bias_gradient, line_b.range_bias_gradient;
+  corner.range_bias_gradient = J_polar * (J_vertex * lines_bias_gradient);
   corner.p_SC = p_SC;
   corner.kind = beyond_a > 0.0 ? CornerKind::kConvex : CornerKind::kConcave;
   return corner;

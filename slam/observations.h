@@ -13,6 +13,10 @@ struct LineObservation {
   double alpha_rad = 0.0;
   /// Covariance of (rho, alpha), from the total-least-squares fit.
   Eigen::Matrix2d covariance = Eigen::Matrix2d::Zero();
+  /// d (rho, alpha) / d b: how the fit moves when every range of its points
+  /// is off by a bias b (each point shifted along its beam), to first order.
+  /// (rho, 0) for a wall seen square on; less where the beams graze it.
+  Eigen::Vector2d range_bias_gradient = Eigen::Vector2d::Zero();
   /// Endpoints of the seen segment in S (the first and last fitted points
   /// projected onto the line), metres; `p_SA` has the smaller beam index.
   Eigen::Vector2d p_SA = Eigen::Vector2d::Zero();
@@ -34,6 +38,8 @@ struct CornerObservation {
   double bearing_rad = 0.0;
   /// Covariance of (range, bearing), from the two lines' covariances.
   Eigen::Matrix2d covariance = Eigen::Matrix2d::Zero();
+  /// d (range, bearing) / d b for a range bias b, from the two lines'.
+  Eigen::Vector2d range_bias_gradient = Eigen::Vector2d::Zero();
   /// The vertex in Cartesian form in S, metres.
   Eigen::Vector2d p_SC = Eigen::Vector2d::Zero();
   CornerKind kind = CornerKind::kConcave;

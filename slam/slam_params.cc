@@ -73,6 +73,16 @@ std::vector<ParamProblem> OdometryNoiseParams::Validate() const {
   return check.problems();
 }
 
+std::vector<ParamProblem> SelfCalibrationParams::Validate() const {
+  ParamChecker check;
+  check.InRange("distance_scale_std", distance_scale_std, 0.0, 0.5);
+  check.InRange("heading_scale_std", heading_scale_std, 0.0, 0.5);
+  check.InRange("heading_per_m_std_rad", heading_per_m_std_rad, 0.0, 1.0);
+  check.InRange("range_bias_std_m", range_bias_std_m, 0.0, 1.0);
+  check.InRange("range_scale_std", range_scale_std, 0.0, 0.5);
+  return check.problems();
+}
+
 std::vector<ParamProblem> EkfParams::Validate() const {
   ParamChecker check;
   check.OneOf("input", input, {"command", "odometry"});
@@ -95,6 +105,7 @@ std::vector<ParamProblem> EkfParams::Validate() const {
   check.NonNegative("command_ramp_radps2", command_ramp_radps2);
   check.Merge("command_noise", command_noise.Validate());
   check.Merge("odometry_noise", odometry_noise.Validate());
+  check.Merge("self_calibration", self_calibration.Validate());
   check.NonNegative("lateral_slip_std_m_per_rad", lateral_slip_std_m_per_rad);
   check.NonNegative("lateral_slip_std_m_per_rad_per_mps", lateral_slip_std_m_per_rad_per_mps);
   check.NonNegative("lateral_slip_std_m_per_radps_change", lateral_slip_std_m_per_radps_change);

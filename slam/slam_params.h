@@ -191,6 +191,45 @@ struct OdometryNoiseParams {
   void ValidateOrThrow() const { ThrowIfProblems(Validate()); }
 };
 
+/// Self-calibration (docs/method.md, "Self-calibration"): the robot's
+/// systematic errors estimated in the state, next to the pose, each from a
+/// zero-mean prior of the standard deviation given here (the envelope of the
+/// robots the filter is meant for). With any of them > 0 the state gains
+/// five entries after the pose, in this order:
+///   q_d  the motion increment's distance scale error: d -> (1 + q_d) d;
+///   q_th the heading increment's scale error: dth -> (1 + q_th) dth + k d;
+///   k    the heading change per metre (rad/m): unequal wheels drive an arc;
+///   b    the laser's range bias (m): every range r -> r + b;
+///   s    the laser's range scale error: r -> (1 + s) r.
+/// An entry whose standard deviation is 0 stays at 0 (its rows of P are 0).
+/// Serialized under `slam.ekf.self_calibration.*`; all 0 (the default and
+/// the paper): the state is the paper's [x, y, th, features].
+struct SelfCalibrationParams {
+  double distance_scale_std = 0.0;
+  double heading_scale_std = 0.0;
+  double heading_per_m_std_rad = 0.0;
+  double range_bias_std_m = 0.0;
+  double range_scale_std = 0.0;
+
+  /// True when any entry is estimated.
+  bool Enabled() const {
+    return distance_scale_std > 0.0 || heading_scale_std > 0.0 || heading_per_m_std_rad > 0.0 ||
+           range_bias_std_m > 0.0 || range_scale_std > 0.0;
+  }
+
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit(MJSLAM_NVP(distance_scale_std));
+    a->Visit(MJSLAM_NVP(heading_scale_std));
+    a->Visit(MJSLAM_NVP(heading_per_m_std_rad));
+    a->Visit(MJSLAM_NVP(range_bias_std_m));
+    a->Visit(MJSLAM_NVP(range_scale_std));
+  }
+  /// Every out-of-range field, keys relative to this struct.
+  std::vector<ParamProblem> Validate() const;
+  void ValidateOrThrow() const { ThrowIfProblems(Validate()); }
+};
+
 /// How the wheels follow the command (EkfParams::command_lag_s,
 /// command_lag_w_s, command_max_accel_mps2; departures 21 and 27).
 struct CommandFollowing {
@@ -257,6 +296,8 @@ struct EkfParams {
   CommandNoiseParams command_noise;
   /// Input noise when `input` is "odometry".
   OdometryNoiseParams odometry_noise;
+  /// The systematic errors estimated in the state (SelfCalibrationParams).
+  SelfCalibrationParams self_calibration;
   /// Lateral slip of R per radian turned, one standard deviation, metres per
   /// radian, with either input: what the skid below leaves unmodelled. The
   /// prediction adds (k |dth|)^2 of variance across the mid-arc heading
@@ -393,6 +434,7 @@ struct EkfParams {
     a->Visit(MJSLAM_NVP(command_ramp_radps2));
     a->Visit(MJSLAM_NVP(command_noise));
     a->Visit(MJSLAM_NVP(odometry_noise));
+    a->Visit(MJSLAM_NVP(self_calibration));
     a->Visit(MJSLAM_NVP(lateral_slip_std_m_per_rad));
     a->Visit(MJSLAM_NVP(lateral_slip_std_m_per_rad_per_mps));
     a->Visit(MJSLAM_NVP(lateral_slip_std_m_per_radps_change));

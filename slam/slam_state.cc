@@ -25,14 +25,33 @@ constexpr double kMinCornerRange = 1e-9;
 }  // namespace
 
 SlamState::SlamState(const Eigen::Vector3d& pose_WR, const Eigen::Matrix3d& pose_covariance,
-                     const Pose2& X_RS, JacobianPoint jacobians)
+                     const Pose2& X_RS, JacobianPoint jacobians,
+                     const Eigen::VectorXd& calibration_std)
     : X_RS_(X_RS), x_(pose_WR), jacobians_(jacobians) {
+  MJSLAM_CHECK(calibration_std.size() == 0 || calibration_std.size() == kCalibrationSize);
   x_.z() = WrapAngleFast(x_.z());
+  vehicle_size_ = 3 + static_cast<int>(calibration_std.size());
+  n_ = vehicle_size_;
+  x_.conservativeResize(n_);
+  x_.tail(n_ - 3).setZero();
   if (jacobians_ == JacobianPoint::kFirstEstimates) x_first_ = x_;
-  const int capacity = PaddedSize(3 + 2 * kInitialFeatureCapacity);
+  const int capacity = PaddedSize(vehicle_size_ + 2 * kInitialFeatureCapacity);
   P_ = Eigen::MatrixXd::Zero(capacity, capacity);
   P_.topLeftCorner<3, 3>() = 0.5 * (pose_covariance + pose_covariance.transpose());
+  for (int i = 0; i < calibration_std.size(); ++i) {
+    MJSLAM_CHECK(calibration_std[i] >= 0.0);
+    P_(3 + i, 3 + i) = calibration_std[i] * calibration_std[i];
+  }
   scratch_ = Eigen::MatrixXd::Zero(capacity, 2);
+}
+
+Eigen::Matrix2d SlamState::LaserErrorJacobian(const Eigen::Vector2d& z,
+                                              const Eigen::Vector2d& range_bias_gradient) {
+  // A scale error s moves every point along its beam by s r: a line
+  // (rho, alpha) becomes (rho (1 + s), alpha), a corner's range d (1 + s).
+  Eigen::Matrix2d E;
+  E << range_bias_gradient.x(), z.x(), range_bias_gradient.y(), 0.0;
+  return E;
 }
 
 Eigen::Matrix<double, 5, 5> SlamState::JointCovariance(int k) const {
@@ -46,6 +65,10 @@ Eigen::Matrix<double, 5, 5> SlamState::JointCovariance(int k) const {
 }
 
 void SlamState::Predict(const MotionInput& input, double a_m) {
+  if (calibrated()) {
+    PredictCalibrated(input, a_m);
+    return;
+  }
   Eigen::Matrix3d A;
   Eigen::Matrix<double, 3, 2> W;
   x_.head<3>() = PredictPose(x_.head<3>(), input.increment, a_m, &A, &W, input.skid_per_m_rad,
@@ -84,6 +107,56 @@ void SlamState::Predict(const MotionInput& input, double a_m) {
   P_.block(0, 3, 3, m) = P_.block(3, 0, m, 3).transpose();
 }
 
+void SlamState::PredictCalibrated(const MotionInput& raw, double a_m) {
+  // The increment corrected by the odometry's estimated errors, and its
+  // derivatives by the raw increment (D) and by (q_d, q_th, k) (C).
+  const double d = raw.increment.x();
+  const double dth = raw.increment.y();
+  const double q_d = x_[kDistanceScale];
+  const double q_th = x_[kHeadingScale];
+  const double k = x_[kHeadingPerMetre];
+  MotionInput input = raw;
+  input.increment = Eigen::Vector2d((1.0 + q_d) * d, (1.0 + q_th) * dth + k * d);
+  Eigen::Matrix2d D;
+  D << 1.0 + q_d, 0.0, k, 1.0 + q_th;
+  input.covariance = D * raw.covariance * D.transpose();
+  Eigen::Matrix<double, 2, 3> C;
+  C << d, 0.0, 0.0, 0.0, dth, d;
+
+  Eigen::Matrix3d A;
+  Eigen::Matrix<double, 3, 2> W;
+  x_.head<3>() = PredictPose(x_.head<3>(), input.increment, a_m, &A, &W, input.skid_per_m_rad,
+                             input.integration, input.turn_centre);
+  if (jacobians_ == JacobianPoint::kFirstEstimates) {
+    A(0, 2) = -(x_.y() - x_first_.y());
+    A(1, 2) = x_.x() - x_first_.x();
+    x_first_.head<3>() = x_.head<3>();
+  }
+  // B = d pose' / d (q_d, q_th, k), at state indices 3-5.
+  const Eigen::Matrix3d B = W * C;
+
+  // The pose is p' = A p + B q + noise: every row r of P gets
+  // P_rp' = P_rp A^T + P_rq B^T (T below, from the old values), and the
+  // pose block A T_p + B T_q + W Q W^T.
+  const int n = n_;
+  Eigen::MatrixXd T(n, 3);
+  T.noalias() = P_.block(0, 0, n, 3) * A.transpose();
+  T.noalias() += P_.block(0, kDistanceScale, n, 3) * B.transpose();
+  Eigen::Matrix3d P_pp_new;
+  P_pp_new.noalias() = A * T.topRows<3>();
+  P_pp_new.noalias() += B * T.middleRows<3>(kDistanceScale);
+  P_pp_new.noalias() += W * input.covariance * W.transpose();
+  if (input.lateral_variance_m2 > 0.0) {
+    const double mid_heading = x_.z() - 0.5 * input.increment.y();
+    const Eigen::Vector2d across(-std::sin(mid_heading), std::cos(mid_heading));
+    P_pp_new.topLeftCorner<2, 2>().noalias() +=
+        input.lateral_variance_m2 * across * across.transpose();
+  }
+  P_.block(3, 0, n - 3, 3) = T.bottomRows(n - 3);
+  P_.block(0, 3, 3, n - 3) = T.bottomRows(n - 3).transpose();
+  P_.topLeftCorner<3, 3>() = 0.5 * (P_pp_new + P_pp_new.transpose());
+}
+
 bool SlamState::PredictWithJacobians(int k, Eigen::Vector2d* h,
                                      Eigen::Matrix<double, 2, 3>* H_pose,
                                      Eigen::Matrix2d* H_feature) const {
@@ -120,21 +193,44 @@ SlamState::Measurement SlamState::Measure(int k) const {
   Eigen::Matrix2d HPHt;
   HPHt.noalias() = H * P_block * H.transpose();
   m.HPHt = 0.5 * (HPHt + HPHt.transpose());
+  if (calibrated()) {
+    const int j = FeatureIndex(k);
+    m.HP_laser.noalias() = m.H_pose * P_.block<3, 2>(0, kRangeBias);
+    m.HP_laser.noalias() += m.H_feature * P_.block<2, 2>(j, kRangeBias);
+  }
   m.valid = true;
   return m;
 }
 
-SlamState::Measurement SlamState::MeasureFor(int k, const Eigen::Vector2d& z) const {
-  Measurement m = Measure(k);
-  if (m.valid && types_[k] == FeatureType::kLine) {
-    AlignLineToObservation(z, &m.h, &m.H_pose, &m.H_feature, &m.HPHt);
+void SlamState::ToObservation(FeatureType type, const Eigen::Vector2d& z,
+                              const Eigen::Vector2d& range_bias_gradient, Measurement* m) const {
+  if (!m->valid) return;
+  if (type == FeatureType::kLine &&
+      AlignLineToObservation(z, &m->h, &m->H_pose, &m->H_feature, &m->HPHt)) {
+    m->HP_laser.row(0) *= -1.0;
   }
+  if (!calibrated()) return;
+  // h + E (b, s); H P H^T + HP_l E^T + E HP_l^T + E P_ll E^T.
+  const Eigen::Matrix2d E = LaserErrorJacobian(z, range_bias_gradient);
+  m->h += E * x_.segment<2>(kRangeBias);
+  Eigen::Matrix2d cross;
+  cross.noalias() = m->HP_laser * E.transpose();
+  Eigen::Matrix2d HPHt = m->HPHt + cross + cross.transpose();
+  HPHt.noalias() += E * P_.block<2, 2>(kRangeBias, kRangeBias) * E.transpose();
+  m->HPHt = 0.5 * (HPHt + HPHt.transpose());
+}
+
+SlamState::Measurement SlamState::MeasureFor(int k, const Eigen::Vector2d& z,
+                                             const Eigen::Vector2d& range_bias_gradient) const {
+  Measurement m = Measure(k);
+  ToObservation(types_[k], z, range_bias_gradient, &m);
   return m;
 }
 
 Eigen::Matrix2d SlamState::InnovationCovariance(int k, const Eigen::Vector2d& z,
-                                                const Eigen::Matrix2d& R) const {
-  const Measurement m = MeasureFor(k, z);
+                                                const Eigen::Matrix2d& R,
+                                                const Eigen::Vector2d& range_bias_gradient) const {
+  const Measurement m = MeasureFor(k, z, range_bias_gradient);
   MJSLAM_CHECK(m.valid);
   return m.HPHt + R;
 }
@@ -148,7 +244,15 @@ void SlamState::Reserve(int n) {
   scratch_ = Eigen::MatrixXd::Zero(capacity, 2);
 }
 
-int SlamState::AddFeature(FeatureType type, const Eigen::Vector2d& z, const Eigen::Matrix2d& R) {
+int SlamState::AddFeature(FeatureType type, const Eigen::Vector2d& z_observed,
+                          const Eigen::Matrix2d& R, const Eigen::Vector2d& range_bias_gradient) {
+  // With self-calibration, the observation less the laser's estimated errors.
+  Eigen::Matrix2d E = Eigen::Matrix2d::Zero();
+  Eigen::Vector2d z = z_observed;
+  if (calibrated()) {
+    E = LaserErrorJacobian(z_observed, range_bias_gradient);
+    z -= E * x_.segment<2>(kRangeBias);
+  }
   // Inverse observation model and its Jacobians at the current pose.
   Eigen::Matrix<double, 2, 3> G_pose;
   Eigen::Matrix2d G_z;
@@ -172,13 +276,25 @@ int SlamState::AddFeature(FeatureType type, const Eigen::Vector2d& z, const Eige
 
   // Cross-covariance with everything so far: P_fx = G_pose P_px. By symmetry
   // P_px^T is the first three columns, so the new columns are contiguous.
+  // With self-calibration also G_l P_lx, G_l = -G_z E on the laser's (b, s).
   P_.block(0, j, n_, 2).noalias() = P_.block(0, 0, n_, 3) * G_pose.transpose();
+  Eigen::Matrix2d G_laser = Eigen::Matrix2d::Zero();
+  if (calibrated()) {
+    G_laser = -G_z * E;
+    P_.block(0, j, n_, 2).noalias() += P_.block(0, kRangeBias, n_, 2) * G_laser.transpose();
+  }
   P_.block(j, 0, 2, n_) = P_.block(0, j, n_, 2).transpose();
 
   // The feature's own block.
   const Eigen::Matrix3d P_pp = P_.topLeftCorner<3, 3>();
   Eigen::Matrix2d P_ff;
-  P_ff.noalias() = G_pose * P_pp * G_pose.transpose();
+  if (calibrated()) {
+    // G_v P_vv G_v^T over the pose and (b, s): P_fx's rows there, times G_v^T.
+    P_ff.noalias() = P_.block<2, 3>(j, 0) * G_pose.transpose();
+    P_ff.noalias() += P_.block<2, 2>(j, kRangeBias) * G_laser.transpose();
+  } else {
+    P_ff.noalias() = G_pose * P_pp * G_pose.transpose();
+  }
   P_ff.noalias() += G_z * R * G_z.transpose();
   P_.block<2, 2>(j, j) = 0.5 * (P_ff + P_ff.transpose());
 
@@ -225,7 +341,8 @@ int SlamState::Append(FeatureType type, const Eigen::Vector2d& f) {
 
 Eigen::Vector2d SlamState::WhitenedGain(int j, const Eigen::Matrix<double, 2, 3>& H_pose,
                                         const Eigen::Matrix2d& H_feature,
-                                        const Eigen::Matrix2d& R, const Eigen::Vector2d& nu) {
+                                        const Eigen::Matrix2d& E, const Eigen::Matrix2d& R,
+                                        const Eigen::Vector2d& nu) {
   const int n = n_;
   const Eigen::Index stride = P_.outerStride();
   const double* p0 = P_.data();
@@ -251,6 +368,21 @@ Eigen::Vector2d SlamState::WhitenedGain(int j, const Eigen::Matrix<double, 2, 3>
   H << H_pose, H_feature;
   Eigen::Matrix2d S;
   S.noalias() = H * U_block;
+  if (calibrated()) {
+    // With self-calibration H also has E on the laser's (b, s): U gains
+    // P_.l E^T, and S = [H E] [U; U_l], with U_l the (b, s) rows of the new U.
+    const double* pb = p0 + kRangeBias * stride;
+    const double* ps = pb + stride;
+    for (int r = 0; r < n; ++r) {
+      u0[r] += E(0, 0) * pb[r] + E(0, 1) * ps[r];
+      u1[r] += E(1, 0) * pb[r] + E(1, 1) * ps[r];
+    }
+    U_block << u0[0], u1[0], u0[1], u1[1], u0[2], u1[2], u0[j], u1[j], u0[j + 1], u1[j + 1];
+    Eigen::Matrix2d U_laser;
+    U_laser << u0[kRangeBias], u1[kRangeBias], u0[kRangeScale], u1[kRangeScale];
+    S.noalias() = H * U_block;
+    S.noalias() += E * U_laser;
+  }
   S += R;
   S = 0.5 * (S + S.transpose());
 
@@ -324,7 +456,8 @@ void SlamState::WrapAngles() {
   }
 }
 
-void SlamState::Update(int k, const Eigen::Vector2d& z, const Eigen::Matrix2d& R) {
+void SlamState::Update(int k, const Eigen::Vector2d& z, const Eigen::Matrix2d& R,
+                       const Eigen::Vector2d& range_bias_gradient) {
   MJSLAM_CHECK(k >= 0 && k < num_features());
   // The prediction, its Jacobians and the innovation.
   Eigen::Matrix<double, 2, 3> H_pose;
@@ -332,10 +465,15 @@ void SlamState::Update(int k, const Eigen::Vector2d& z, const Eigen::Matrix2d& R
   Eigen::Vector2d h;
   MJSLAM_CHECK(PredictWithJacobians(k, &h, &H_pose, &H_feature));
   if (types_[k] == FeatureType::kLine) AlignLineToObservation(z, &h, &H_pose, &H_feature);
+  Eigen::Matrix2d E = Eigen::Matrix2d::Zero();
+  if (calibrated()) {
+    E = LaserErrorJacobian(z, range_bias_gradient);
+    h += E * x_.segment<2>(kRangeBias);
+  }
   const Eigen::Vector2d nu = Innovation(z, h);
 
   // The correction, then the angles back into (-pi, pi].
-  const Eigen::Vector2d w = WhitenedGain(FeatureIndex(k), H_pose, H_feature, R, nu);
+  const Eigen::Vector2d w = WhitenedGain(FeatureIndex(k), H_pose, H_feature, E, R, nu);
   ApplyGain(w);
   WrapAngles();
 }

@@ -29,6 +29,18 @@ namespace mjslam::slam {
 /// harmless, and EkfSlam::Map() reports the canonical form.
 class SlamState {
  public:
+  /// Self-calibration (SelfCalibrationParams): when on, the state is
+  /// [x, y, th, q_d, q_th, k, b, s, features], the five entries at these
+  /// state indices; the odometry's three change the prediction, the laser's
+  /// two every observation (z = h(pose, f) + E (b, s), E = [g, (z_0, 0)],
+  /// g the observation's range_bias_gradient).
+  static constexpr int kCalibrationSize = 5;
+  static constexpr int kDistanceScale = 3;
+  static constexpr int kHeadingScale = 4;
+  static constexpr int kHeadingPerMetre = 5;
+  static constexpr int kRangeBias = 6;
+  static constexpr int kRangeScale = 7;
+
   /// Predicted measurement of one feature from the current state, with the
   /// model's Jacobians and H P H^T (without R).
   struct Measurement {
@@ -40,8 +52,13 @@ class SlamState {
     Eigen::Matrix<double, 2, 3> H_pose = Eigen::Matrix<double, 2, 3>::Zero();
     /// d h / d feature.
     Eigen::Matrix2d H_feature = Eigen::Matrix2d::Zero();
-    /// H P H^T over the 5x5 block of the pose and the feature.
+    /// H P H^T over the 5x5 block of the pose and the feature, plus, once
+    /// ToObservation has added the laser's systematic errors, their terms.
     Eigen::Matrix2d HPHt = Eigen::Matrix2d::Zero();
+    /// With self-calibration: [H_pose H_feature] P_(pose, f),(b, s), the
+    /// model prediction's covariance with the laser's bias and scale (0
+    /// without).
+    Eigen::Matrix2d HP_laser = Eigen::Matrix2d::Zero();
   };
 
   /// A state with no features: pose (x, y, th) of R in W (metres, radians),
@@ -53,17 +70,25 @@ class SlamState {
   /// step (the initial pose before the first prediction), and A of the
   /// prediction from the previous predicted pose to the new one; the
   /// predictions h themselves and W stay at the current mean.
+  /// `calibration_std`: empty (no self-calibration) or the five prior
+  /// standard deviations of (q_d, q_th, k, b, s), each >= 0; the entries
+  /// start at 0, uncorrelated with the pose.
   SlamState(const Eigen::Vector3d& pose_WR, const Eigen::Matrix3d& pose_covariance,
-            const Pose2& X_RS, JacobianPoint jacobians = JacobianPoint::kCurrent);
+            const Pose2& X_RS, JacobianPoint jacobians = JacobianPoint::kCurrent,
+            const Eigen::VectorXd& calibration_std = Eigen::VectorXd());
 
-  /// n = 3 + 2 L.
+  /// n = v + 2 L, v = 3 (+ 5 with self-calibration).
   int dimension() const { return n_; }
+  /// Whether the state holds the five self-calibration entries.
+  bool calibrated() const { return vehicle_size_ > 3; }
+  /// The self-calibration entries (q_d, q_th, k, b, s); empty without.
+  Eigen::VectorXd calibration() const { return x_.segment(3, vehicle_size_ - 3); }
   /// L.
   int num_features() const { return static_cast<int>(types_.size()); }
   /// Type of feature k.
   FeatureType feature_type(int k) const { return types_[k]; }
   /// State index of feature k's first component.
-  static int FeatureIndex(int k) { return 3 + 2 * k; }
+  int FeatureIndex(int k) const { return vehicle_size_ + 2 * k; }
 
   /// The mean xi (size n).
   const Eigen::VectorXd& mean() const { return x_; }
@@ -100,6 +125,9 @@ class SlamState {
   /// control point `a_m` ahead of the axle; s^2 = input.lateral_variance_m2
   /// and n the unit vector across the mid-arc heading (position rows only).
   /// O(n): only the pose rows and columns change.
+  /// With self-calibration the increment (d, dth) is first corrected to
+  /// ((1 + q_d) d, (1 + q_th) dth + k d), its covariance carried through, and
+  /// A extended by d pose' / d (q_d, q_th, k).
   void Predict(const MotionInput& input, double a_m);
 
   /// Predicted measurement of feature k at the current mean, canonical for
@@ -107,7 +135,17 @@ class SlamState {
   Measurement Measure(int k) const;
   /// Measure(k) for comparison with observation z: a line's prediction in
   /// z's polar form (AlignLineToObservation). O(1).
-  Measurement MeasureFor(int k, const Eigen::Vector2d& z) const;
+  /// `range_bias_gradient`: the observation's (LineObservation's or
+  /// CornerObservation's); with self-calibration the prediction then adds
+  /// the laser's errors, E (b, s), and H P H^T their covariance
+  /// (ToObservation).
+  Measurement MeasureFor(int k, const Eigen::Vector2d& z,
+                         const Eigen::Vector2d& range_bias_gradient = Eigen::Vector2d::Zero()) const;
+  /// Measure(k)'s result made a prediction of observation z: a line's in z's
+  /// polar form, then, with self-calibration, the laser's systematic errors
+  /// added to h and H P H^T.
+  void ToObservation(FeatureType type, const Eigen::Vector2d& z,
+                     const Eigen::Vector2d& range_bias_gradient, Measurement* m) const;
 
   /// Augments the state with a feature initialised from observation z with
   /// covariance R (2x2 SPD) by the inverse observation model g:
@@ -116,7 +154,10 @@ class SlamState {
   /// With kFirstEstimates, G_pose is taken at the pose's linearisation point
   /// and f (that of the observation h(pose_lin, f)).
   /// O(n) (amortised: the buffer doubles when full). Returns the new index k.
-  int AddFeature(FeatureType type, const Eigen::Vector2d& z, const Eigen::Matrix2d& R);
+  /// With self-calibration z is first corrected for the laser's errors,
+  /// z - E (b, s), and G extended by -G_z E on their columns.
+  int AddFeature(FeatureType type, const Eigen::Vector2d& z, const Eigen::Matrix2d& R,
+                 const Eigen::Vector2d& range_bias_gradient = Eigen::Vector2d::Zero());
 
   /// Augments the state with the corner where map lines a and b meet, a
   /// function of the state: f = IntersectLines(f_a, f_b) = c, P_fx = J P_(ab)x,
@@ -134,12 +175,14 @@ class SlamState {
   ///   S = L L^T. P H^T uses 5 columns of P; the downdate is O(n^2) with no
   ///   dense n x n product. Angles are wrapped afterwards. Precondition
   ///   (checked): Measure(k).valid and S positive definite.
-  void Update(int k, const Eigen::Vector2d& z, const Eigen::Matrix2d& R);
+  void Update(int k, const Eigen::Vector2d& z, const Eigen::Matrix2d& R,
+              const Eigen::Vector2d& range_bias_gradient = Eigen::Vector2d::Zero());
 
   /// The innovation covariance S = H P H^T + R of observation z of feature k
   /// with covariance R. O(1).
-  Eigen::Matrix2d InnovationCovariance(int k, const Eigen::Vector2d& z,
-                                       const Eigen::Matrix2d& R) const;
+  Eigen::Matrix2d InnovationCovariance(
+      int k, const Eigen::Vector2d& z, const Eigen::Matrix2d& R,
+      const Eigen::Vector2d& range_bias_gradient = Eigen::Vector2d::Zero()) const;
 
  private:
   // Makes room for `n` state entries, doubling the buffer if needed.
@@ -151,9 +194,15 @@ class SlamState {
   // into scratch_ (H = [H_pose at the pose, H_feature at state index j]),
   // with S = H P H^T + R = L L^T, and returns L^-1 nu, so that K nu = V L^-1 nu.
   // Precondition (checked): S positive definite.
+  // E: d h / d (b, s) with self-calibration (unused without).
   Eigen::Vector2d WhitenedGain(int j, const Eigen::Matrix<double, 2, 3>& H_pose,
-                               const Eigen::Matrix2d& H_feature, const Eigen::Matrix2d& R,
-                               const Eigen::Vector2d& nu);
+                               const Eigen::Matrix2d& H_feature, const Eigen::Matrix2d& E,
+                               const Eigen::Matrix2d& R, const Eigen::Vector2d& nu);
+  // The prediction with self-calibration (Predict).
+  void PredictCalibrated(const MotionInput& input, double a_m);
+  // E = [g, (z_0, 0)]: d z / d (b, s).
+  static Eigen::Matrix2d LaserErrorJacobian(const Eigen::Vector2d& z,
+                                            const Eigen::Vector2d& range_bias_gradient);
   // xi <- xi + V w and P <- P - V V^T with V in scratch_ (from WhitenedGain).
   void ApplyGain(const Eigen::Vector2d& w);
   // Wraps the heading and every line's alpha into (-pi, pi].
@@ -166,6 +215,8 @@ class SlamState {
                             Eigen::Matrix2d* H_feature) const;
 
   Pose2 X_RS_;
+  // 3, or 3 + kCalibrationSize with self-calibration.
+  int vehicle_size_ = 3;
   int n_ = 3;
   Eigen::VectorXd x_;
   // Capacity x capacity buffer; P is its top-left n_ x n_ block.

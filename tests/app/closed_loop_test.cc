@@ -202,7 +202,10 @@ namespace {
 std::vector<double> TruePath(std::uint64_t seed, double fraction,
                              const std::string& disturbance = "twist") {
   RunConfig config = ShortConfig({"control.pose_source=odometry", "laser.range_noise_std_m=0",
-                                  "odometry.slip_std_fraction=0",
+                                  "laser.range_bias_std_m=0", "odometry.slip_std_fraction=0",
+                                  "odometry.wheel_radius_error_std_fraction=0",
+                                  "odometry.axle_track_error_std_fraction=0",
+                                  "odometry.correlated_slip_std_fraction=0",
                                   "sim.drive_disturbance=" + disturbance});
   config.run.seed = seed;
   config.sim.drive_disturbance_std_fraction = fraction;

@@ -1,5 +1,5 @@
-// Monte Carlo regression tests on consistency: 25 seeded runs of 12 s in the
-// small room (worlds/room.xml; the robot drives the first, straight leg of
+// Monte Carlo regression tests on consistency: 25 seeded runs of 12 s of
+// configs/calibrated_corridor.yaml in the small room (worlds/room.xml; the robot drives the first, straight leg of
 // the tour), through `mjslam sweep`, and the average pose NEES of each filter
 // against the two-sided 95 % chi-square bounds for 25 runs, 3 dof
 // ([2.118, 4.034]). Seeds 1..25 (run.seed = 1 plus the run index). And
@@ -25,8 +25,9 @@ constexpr int kRuns = 25;
 // Runs `runs` runs of the default config with `overrides` through the sweep
 // and returns its summary.
 nlohmann::json SweepOf(const std::string& name, int runs,
-                       const std::vector<std::string>& overrides) {
-  const app::RunConfig config = app::LoadRunConfig(DefaultConfig(), overrides);
+                       const std::vector<std::string>& overrides,
+                       const std::string& config_path = DefaultConfig()) {
+  const app::RunConfig config = app::LoadRunConfig(config_path, overrides);
   app::SweepOptions options;
   options.runs = runs;
   options.jobs = 2;
@@ -47,13 +48,21 @@ nlohmann::json SweepOf(const std::string& name, int runs,
   return result.summary;
 }
 
-// The room sweep of kRuns runs, with extra overrides.
+// configs/calibrated_corridor.yaml: the robot without systematic errors and
+// the filters' command model fitted to its true motion.
+std::string CalibratedCorridorConfig() {
+  return std::string(MJSLAM_SOURCE_DIR) + "/configs/calibrated_corridor.yaml";
+}
+
+// The room sweep of kRuns runs of configs/calibrated_corridor.yaml, with extra
+// overrides. (The default, which predicts with the wheel odometry and
+// estimates its errors, is underconfident on this 12 s leg: mean ANEES 1.95.)
 nlohmann::json Sweep(const std::string& name, const std::vector<std::string>& extra) {
   std::vector<std::string> overrides = {
       "run.world=" + std::string(MJSLAM_SOURCE_DIR) + "/worlds/room.xml", "run.duration_s=12",
       "run.seed=1", "control.driver=tour"};
   overrides.insert(overrides.end(), extra.begin(), extra.end());
-  return SweepOf(name, kRuns, overrides);
+  return SweepOf(name, kRuns, overrides, CalibratedCorridorConfig());
 }
 
 class ConsistencyTest : public ::testing::Test {
@@ -101,9 +110,8 @@ TEST(ConsistencyCheckTest, DetectsMeasurementNoiseUnderstatedTenTimes) {
 }
 
 // The explorer's closed loop in the default world (the corridor loop) with
-// the default config (the drive disturbed by 1 % a step, wheel by wheel, and
-// the process model fitted to that robot's true motion; configs/default.yaml's
-// header), 10 runs, seeds 1..10, each until exploration ends (about 150 s).
+// configs/calibrated_corridor.yaml (the drive disturbed by 1 % a step, wheel
+// by wheel, and the process model fitted to that robot's true motion), 10 runs, seeds 1..10, each until exploration ends (about 150 s).
 // One sweep, two checks:
 // - the turns: neither filter's average NEES may go above its upper bound
 //   (for the runs still going at that step) for more than 5 % of the steps.
@@ -122,7 +130,8 @@ TEST(ConsistencyCheckTest, DetectsMeasurementNoiseUnderstatedTenTimes) {
 TEST(ClosedLoopConsistencyTest, TurnsAndInnovationsOfTheDefault) {
   const std::string dir = FreshDir("closed_loop");
   const nlohmann::json summary =
-      SweepOf("closed_loop", 10, {"run.seed=1", "render.enabled=false"});
+      SweepOf("closed_loop", 10, {"run.seed=1", "render.enabled=false"},
+              CalibratedCorridorConfig());
   EXPECT_GE(summary["sweep"]["steps"].get<int>(), 500);
   for (const std::string f : {"classical", "selective"}) {
     EXPECT_LE(summary["filters"][f]["fraction_above"].get<double>(), 0.05) << f;
@@ -142,7 +151,7 @@ TEST(ClosedLoopConsistencyTest, TurnsAndInnovationsOfTheDefault) {
   }
 }
 
-// The target of calibrated noise with the default config (the drive
+// The target of calibrated noise with configs/calibrated_corridor.yaml (the drive
 // disturbed wheel by wheel, the process model fitted to that simulator's
 // true motion on seeds 101-125): 25-run Monte Carlos of the explorer in the
 // corridor loop, each run until exploration ends, with both filters' ANEES
@@ -179,7 +188,8 @@ TEST(CalibratedMonteCarloTest, BothFiltersAreConsistentInTheCorridor) {
   std::vector<nlohmann::json> draws;
   for (const int seed : {1, 26, 51, 76}) {
     draws.push_back(SweepOf("calibrated_target_" + std::to_string(seed), kRuns,
-                            {"run.seed=" + std::to_string(seed), "render.enabled=false"}));
+                            {"run.seed=" + std::to_string(seed), "render.enabled=false"},
+                            CalibratedCorridorConfig()));
   }
   for (const std::string f : {"classical", "selective"}) {
     double sum = 0.0;
@@ -202,11 +212,55 @@ TEST(CalibratedMonteCarloTest, UnderstatedNoiseMissesTheTarget) {
   const nlohmann::json summary =
       SweepOf("calibrated_understated", kRuns,
               {"run.seed=1", "render.enabled=false", "slam.ekf.command_noise.v_noise_scale=0.3",
-               "slam.ekf.command_noise.w_noise_scale=0.3"});
+               "slam.ekf.command_noise.w_noise_scale=0.3"},
+              CalibratedCorridorConfig());
   for (const std::string f : {"classical", "selective"}) {
     const DrawFigures figures = FiguresOf(summary, f);
     EXPECT_FALSE(figures.fraction_inside >= 0.85 && figures.components_ok)
         << f << " meets the target with understated noise";
+  }
+}
+
+// A condition of the envelope the default was not built on (docs/method.md,
+// "The envelope"): the laser reads every range 15 mm long, the edge of a
+// SICK's systematic error, in the corridor loop, 25 runs of the explorer,
+// seeds 700-724, each until exploration ends. The default estimates the bias
+// in its state: neither filter may be above its ANEES bound for more than
+// 20 % of the steps, and each pooled pose component lies inside its 2-sigma
+// band for >= 88 % of the steps. Measured (docs/results.md, "The envelope"):
+// above 0.091 / 0.102, 2-sigma x 0.916 / 0.907, y and th 0.98-0.99.
+// configs/calibrated_corridor.yaml, the model fitted to the robot without
+// systematic errors, fails it on the same runs (measured: above for most of
+// the steps): the second test.
+const std::vector<std::string> kRangeBias15mm = {"run.seed=700", "render.enabled=false",
+                                                 "laser.range_bias_m=0.015",
+                                                 "laser.range_bias_std_m=0"};
+
+bool HoldsUnderTheBias(const nlohmann::json& summary, const std::string& f) {
+  const nlohmann::json& s = summary["filters"][f];
+  const nlohmann::json& inside = s["inside_2sigma_pooled"];
+  bool ok = s["fraction_above"].get<double>() <= 0.20;
+  for (const std::string c : {"x", "y", "th"}) ok &= inside[c].get<double>() >= 0.88;
+  std::printf("%s: above %.3f, 2 sigma x %.3f y %.3f th %.3f: %s\n", f.c_str(),
+              s["fraction_above"].get<double>(), inside["x"].get<double>(),
+              inside["y"].get<double>(), inside["th"].get<double>(), ok ? "holds" : "fails");
+  return ok;
+}
+
+TEST(EnvelopeMonteCarloTest, DefaultHoldsWithARangeBiasOf15mm) {
+  const nlohmann::json summary = SweepOf("envelope_bias", kRuns, kRangeBias15mm);
+  EXPECT_GE(summary["sweep"]["steps"].get<int>(), 500);
+  for (const std::string f : {"classical", "selective"}) {
+    EXPECT_TRUE(HoldsUnderTheBias(summary, f)) << f;
+  }
+}
+
+TEST(EnvelopeMonteCarloTest, ModelFittedWithoutSystematicErrorsFailsIt) {
+  const nlohmann::json summary =
+      SweepOf("envelope_bias_calibrated_corridor", kRuns, kRangeBias15mm,
+              CalibratedCorridorConfig());
+  for (const std::string f : {"classical", "selective"}) {
+    EXPECT_FALSE(HoldsUnderTheBias(summary, f)) << f;
   }
 }
 

@@ -70,11 +70,17 @@ TEST(SimParamsTest, SerializeVisitsEveryFieldUnderItsKey) {
   // The noise fields are flat: laser.range_noise_std_m on the command line.
   EXPECT_EQ(Keys<LaserParams>(),
             (std::vector<std::string>{"num_beams", "fov_deg", "max_range_m", "rate_hz",
-                                      "range_noise_std_m", "range_bias_m", "angle_jitter_std_deg",
-                                      "dropout_probability"}));
+                                      "range_noise_std_m", "range_bias_m", "range_bias_std_m",
+                                      "range_scale_fraction", "range_scale_std_fraction",
+                                      "angle_jitter_std_deg", "dropout_probability"}));
   EXPECT_EQ(Keys<OdometryParams>(),
             (std::vector<std::string>{"ticks_per_wheel_revolution", "slip_std_fraction",
-                                      "wheel_radius_error_std_fraction"}));
+                                      "wheel_radius_error_std_fraction",
+                                      "left_wheel_radius_error_fraction",
+                                      "right_wheel_radius_error_fraction",
+                                      "axle_track_error_std_fraction", "axle_track_error_fraction",
+                                      "correlated_slip_std_fraction",
+                                      "slip_correlation_distance_m"}));
 }
 
 TEST(SimParamsTest, BadValuesAreReportedUnderTheirKeys) {

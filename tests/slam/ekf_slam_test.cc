@@ -277,7 +277,7 @@ TEST(EkfSlamTest, NewCornerIsWhereItsMapLinesMeetAndMovesWithThem) {
     EXPECT_NEAR(seen.x(), from_lines ? 2.0 : 2.01, 1e-9);
     EXPECT_NEAR(seen.y(), 1.5, 1e-9);
     const Eigen::Matrix2d corner_line = filter.covariance().block<2, 2>(
-        SlamState::FeatureIndex(2), SlamState::FeatureIndex(0));
+        filter.slam_state().FeatureIndex(2), filter.slam_state().FeatureIndex(0));
     if (from_lines) {
       // x of the corner is rho - 1.5 alpha of the east wall (x cos al +
       // y sin al = rho at y = 1.5, al = 0).

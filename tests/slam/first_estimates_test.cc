@@ -155,7 +155,7 @@ TEST(FirstEstimatesTest, PredictionJacobianFromThePreviousPredictedPose) {
   input.increment = Eigen::Vector2d(0.5, 0.2);
   fej.state.Predict(input, 0.2);
   const Eigen::Vector3d predicted = fej.state.pose();
-  const int j = SlamState::FeatureIndex(fej.k);
+  const int j = fej.state.FeatureIndex(fej.k);
   const double A02 = -(predicted.y() - fej.pose_predicted.y());
   const double A12 = predicted.x() - fej.pose_predicted.x();
   EXPECT_NEAR(fej.state.covariance()(j, 0), P(j, 0) + A02 * P(j, 2), 1e-15);

@@ -54,7 +54,7 @@ Eigen::MatrixXd DenseH(const SlamState& state, int k, const Eigen::Vector2d& z) 
   const SlamState::Measurement m = state.MeasureFor(k, z);
   Eigen::MatrixXd H = Eigen::MatrixXd::Zero(2, state.dimension());
   H.leftCols<3>() = m.H_pose;
-  H.middleCols<2>(SlamState::FeatureIndex(k)) = m.H_feature;
+  H.middleCols<2>(state.FeatureIndex(k)) = m.H_feature;
   return H;
 }
 
@@ -179,7 +179,7 @@ TEST(SlamStateTest, LineIntersectionEqualsDenseComputation) {
     G.topRows(n).setIdentity();
     const double step = 1e-6;
     for (int i = 0; i < 4; ++i) {
-      const int column = SlamState::FeatureIndex(i < 2 ? a : b) + i % 2;
+      const int column = state.FeatureIndex(i < 2 ? a : b) + i % 2;
       Eigen::Vector2d fa_plus = state.feature(a), fa_minus = state.feature(a);
       Eigen::Vector2d fb_plus = state.feature(b), fb_minus = state.feature(b);
       Eigen::Vector2d& plus = i < 2 ? fa_plus : fb_plus;
@@ -205,7 +205,7 @@ TEST(SlamStateTest, LineIntersectionEqualsDenseComputation) {
     // it is correlated with line a.
     EXPECT_GT(state.feature_covariance(k).trace(), 0.0);
     const Eigen::Matrix2d corner_line_a =
-        state.covariance().block<2, 2>(SlamState::FeatureIndex(k), SlamState::FeatureIndex(a));
+        state.covariance().block<2, 2>(state.FeatureIndex(k), state.FeatureIndex(a));
     EXPECT_GT(corner_line_a.cwiseAbs().maxCoeff(), 0.0);
   }
 }
