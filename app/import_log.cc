@@ -244,6 +244,7 @@ nlohmann::json ManifestFields(const ImportOptions& options, const ImportReport& 
                              "lines at each scan's corrected pose)"
                            : "as logged (restarted at each scan's corrected pose)"},
           {"skipped", skipped},
+          {"warnings", report.warnings},
           {"reference", s.has_reference ? "reference.csv: the log's own pose estimate (a SLAM "
                                           "result, not ground truth)"
                                         : "none"},
@@ -319,6 +320,7 @@ ImportReport ImportLog(RunConfig config, const ImportOptions& options) {
   report.has_reference = s.has_reference;
   report.odometry_rebuilt = log.reanchored && !options.read.odometry_as_logged;
   report.skipped = realdata::SkipReport(log);
+  report.warnings = log.warnings;
   if (s.scans_outside > 0) {
     report.skipped.push_back(first.kind + ": outside the odometry's time span: " +
                              std::to_string(s.scans_outside) + " scans");

@@ -59,6 +59,9 @@ struct ImportReport {
   double time_offset_s = 0.0;
   /// realdata::SkipReport of the log, plus the scans left out by the import.
   std::vector<std::string> skipped;
+  /// What the reader did to the log besides skipping lines (e.g. timestamps
+  /// of low precision spread in line order), one sentence each.
+  std::vector<std::string> warnings;
 };
 
 /// `mjslam import`: reads a CARMEN or BreezySLAM log and writes a run directory that

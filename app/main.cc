@@ -241,6 +241,7 @@ int ImportMain(ImportCommand c, const std::string& command_line) {
     std::fprintf(stderr, "  odometry rebuilt from the logged increments (the log restarts it at each scan)\n");
   }
   for (const std::string& line : report.skipped) std::fprintf(stderr, "  skipped %s\n", line.c_str());
+  for (const std::string& line : report.warnings) std::fprintf(stderr, "  warning: %s\n", line.c_str());
   if (!c.options.relations_path.empty()) {
     std::fprintf(stderr, "  relations time offset %.6f s\n", report.time_offset_s);
   }

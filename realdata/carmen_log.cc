@@ -206,16 +206,45 @@ class OdometryChain {
   bool started_ = false;
 };
 
-// Keeps a message whose timestamp is positive and after the last one kept.
+// Keeps a message whose timestamp is positive and not before the last one
+// kept (equal ones are spread afterwards: SpreadTies).
 template <typename Message>
 void Keep(Message message, const std::string& kind, std::vector<Message>* stream, CarmenLog* log) {
   if (message.t_s <= 0.0) {
     ++log->skipped[kind + ": timestamp <= 0"];
-  } else if (!stream->empty() && message.t_s <= stream->back().t_s) {
-    ++log->skipped[kind + ": timestamp not after the previous one"];
+  } else if (!stream->empty() && message.t_s < stream->back().t_s) {
+    ++log->skipped[kind + ": timestamp before the previous one"];
   } else {
     stream->push_back(std::move(message));
   }
+}
+
+// Gives the messages of `stream` that share a timestamp increasing times in
+// line order (ReadCarmenLog documents how) and warns how many there were.
+template <typename Message>
+void SpreadTies(const std::string& kind, std::vector<Message>* stream, CarmenLog* log) {
+  const std::size_t n = stream->size();
+  std::size_t tied = 0;
+  for (std::size_t i = 1; i < n; ++i) tied += (*stream)[i].t_s == (*stream)[i - 1].t_s;
+  if (tied == 0) return;
+  // The mean step, for the last run (which has no next stamp).
+  const double span = stream->back().t_s - stream->front().t_s;
+  const double mean_step = n - tied > 1 ? span / static_cast<double>(n - tied - 1) : 1.0;
+  for (std::size_t begin = 0; begin < n;) {
+    std::size_t end = begin + 1;
+    while (end < n && (*stream)[end].t_s == (*stream)[begin].t_s) ++end;
+    const double t = (*stream)[begin].t_s;
+    const double next = end < n ? (*stream)[end].t_s : t + mean_step;
+    const double k = static_cast<double>(end - begin);
+    for (std::size_t i = begin + 1; i < end; ++i) {
+      (*stream)[i].t_s = t + static_cast<double>(i - begin) * (next - t) / k;
+    }
+    begin = end;
+  }
+  log->warnings.push_back(kind + ": " + std::to_string(tied) + " of " + std::to_string(n) +
+                          " messages share their timestamp with the one before (timestamps of "
+                          "low precision): their times are spread in line order between the "
+                          "neighbouring stamps");
 }
 
 }  // namespace
@@ -298,6 +327,8 @@ CarmenLog ReadCarmenLog(const std::string& path, const CarmenReadOptions& option
       if (log.bad_lines.size() < kMaxBadLinesKept) log.bad_lines.push_back(message);
     }
   }
+  SpreadTies("ODOM", &log.odometry, &log);
+  for (auto& [kind, stream] : log.lasers) SpreadTies(kind, &stream, &log);
   return log;
 }
 

@@ -91,6 +91,9 @@ struct CarmenLog {
   std::vector<std::string> bad_lines;
   /// Lines read.
   int num_lines = 0;
+  /// What the reader did besides skipping lines, one sentence each (e.g.
+  /// timestamps of low precision spread in line order).
+  std::vector<std::string> warnings;
   /// Whether the log re-anchors its odometry: an ODOM line right after a
   /// laser message repeats the message's robot pose (the corrected logs
   /// write each scan's corrected pose so, with timestamp 0), and the ODOM
@@ -111,8 +114,13 @@ double CarmenDefaultStepDeg(int num_beams);
 /// std::runtime_error "PATH:LINE: ..." for a malformed line (unless
 /// options.skip_bad_lines) and "PATH: ..." when the file cannot be read.
 /// Timestamps must increase within a message stream: an ODOM or laser
-/// message whose timestamp is <= 0 or not after the previous one of its kind
+/// message whose timestamp is <= 0 or before the previous one of its kind
 /// (the corrected logs' pose lines, corrupt stamps) is skipped and counted.
+/// Messages that share their timestamp with the one before (a log printed
+/// with few significant digits, e.g. 1.13486e+09) are kept: the k messages
+/// of a stream stamped T get the times T + i (T' - T) / k in line order, T'
+/// the stream's next stamp (after its last stamp: its mean step), and a
+/// warning says how many (CarmenLog::warnings).
 CarmenLog ReadCarmenLog(const std::string& path, const CarmenReadOptions& options = {});
 
 /// The whitespace-separated fields of one line of a text log.

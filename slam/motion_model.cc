@@ -226,7 +226,8 @@ MotionInput OdometryInput(const Pose2& X_OR_previous, const Pose2& X_OR, double 
   // Random-walk slip: variances linear in the distance rolled and the angle turned.
   const double variance_d =
       noise.distance_noise_std_m * noise.distance_noise_std_m +
-      noise.distance_noise_std_m_per_sqrt_m * noise.distance_noise_std_m_per_sqrt_m * distance;
+      noise.distance_noise_std_m_per_sqrt_m * noise.distance_noise_std_m_per_sqrt_m * distance +
+      noise.distance_noise_std_m_per_sqrt_rad * noise.distance_noise_std_m_per_sqrt_rad * turn;
   const double variance_th =
       noise.heading_noise_std_rad * noise.heading_noise_std_rad +
       noise.heading_noise_std_rad_per_sqrt_m * noise.heading_noise_std_rad_per_sqrt_m * distance +

@@ -43,6 +43,9 @@ struct MotionInput {
   TurnCentre turn_centre;
   /// How Eq. (6) is integrated over the step (EkfParams::motion_integration).
   MotionIntegration integration = MotionIntegration::kExact;
+  /// The wheels' track, metres, for self-calibration's term k B^2 / 4 dth
+  /// (SelfCalibrationParams::axle_track_m); unused without it.
+  double axle_track_m = 0.0;
 };
 
 /// The paper's Eq. (6) for the point of control h (frame R, `a_m` ahead of

@@ -67,6 +67,7 @@ std::vector<ParamProblem> OdometryNoiseParams::Validate() const {
   ParamChecker check;
   check.NonNegative("distance_noise_std_m", distance_noise_std_m);
   check.NonNegative("distance_noise_std_m_per_sqrt_m", distance_noise_std_m_per_sqrt_m);
+  check.NonNegative("distance_noise_std_m_per_sqrt_rad", distance_noise_std_m_per_sqrt_rad);
   check.NonNegative("heading_noise_std_rad", heading_noise_std_rad);
   check.NonNegative("heading_noise_std_rad_per_sqrt_m", heading_noise_std_rad_per_sqrt_m);
   check.NonNegative("heading_noise_std_rad_per_sqrt_rad", heading_noise_std_rad_per_sqrt_rad);
@@ -80,6 +81,7 @@ std::vector<ParamProblem> SelfCalibrationParams::Validate() const {
   check.InRange("heading_per_m_std_rad", heading_per_m_std_rad, 0.0, 1.0);
   check.InRange("range_bias_std_m", range_bias_std_m, 0.0, 1.0);
   check.InRange("range_scale_std", range_scale_std, 0.0, 0.5);
+  check.Positive("axle_track_m", axle_track_m);
   return check.problems();
 }
 

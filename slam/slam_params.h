@@ -159,7 +159,8 @@ struct CommandNoiseParams {
 /// heading increment (rad) between two records. Wheel slip is a random walk:
 /// its variance grows with the distance rolled and the angle turned, not with
 /// their squares (so the model does not depend on the record rate):
-///   sigma_d^2   = distance_noise_std_m^2 + distance_noise_std_m_per_sqrt_m^2 |d|,
+///   sigma_d^2   = distance_noise_std_m^2 + distance_noise_std_m_per_sqrt_m^2 |d|
+///                 + distance_noise_std_m_per_sqrt_rad^2 |dth|,
 ///   sigma_dth^2 = heading_noise_std_rad^2 + heading_noise_std_rad_per_sqrt_m^2 |d|
 ///                 + heading_noise_std_rad_per_sqrt_rad^2 |dth|.
 /// The defaults are twice the simulator's default slip (0.5 % of a metre per
@@ -170,6 +171,9 @@ struct OdometryNoiseParams {
   double distance_noise_std_m = 0.0005;
   /// Standard deviation of the distance after 1 m rolled, m per sqrt(m).
   double distance_noise_std_m_per_sqrt_m = 0.007;
+  /// Standard deviation of the distance after 1 rad turned, m per sqrt(rad):
+  /// the wheels' slip moves a robot that turns on the spot forward or back.
+  double distance_noise_std_m_per_sqrt_rad = 0.0;
   /// Noise floor of the heading increment per record, radians.
   double heading_noise_std_rad = 0.0005;
   /// Standard deviation of the heading after 1 m rolled, rad per sqrt(m).
@@ -181,6 +185,7 @@ struct OdometryNoiseParams {
   void Serialize(Archive* a) {
     a->Visit(MJSLAM_NVP(distance_noise_std_m));
     a->Visit(MJSLAM_NVP(distance_noise_std_m_per_sqrt_m));
+    a->Visit(MJSLAM_NVP(distance_noise_std_m_per_sqrt_rad));
     a->Visit(MJSLAM_NVP(heading_noise_std_rad));
     a->Visit(MJSLAM_NVP(heading_noise_std_rad_per_sqrt_m));
     a->Visit(MJSLAM_NVP(heading_noise_std_rad_per_sqrt_rad));
@@ -196,9 +201,12 @@ struct OdometryNoiseParams {
 /// zero-mean prior of the standard deviation given here (the envelope of the
 /// robots the filter is meant for). With any of them > 0 the state gains
 /// five entries after the pose, in this order:
-///   q_d  the motion increment's distance scale error: d -> (1 + q_d) d;
-///   q_th the heading increment's scale error: dth -> (1 + q_th) dth + k d;
-///   k    the heading change per metre (rad/m): unequal wheels drive an arc;
+///   q_d  the motion increment's distance scale error;
+///   q_th the heading increment's scale error;
+///   k    the heading change per metre (rad/m): unequal wheels drive an arc,
+///        and move forward or back when turning on the spot: with the track
+///        B, d -> (1 + q_d) d + k B^2 / 4 dth, dth -> (1 + q_th) dth + k d
+///        (to first order the effect of each wheel's own radius error);
 ///   b    the laser's range bias (m): every range r -> r + b;
 ///   s    the laser's range scale error: r -> (1 + s) r.
 /// An entry whose standard deviation is 0 stays at 0 (its rows of P are 0).
@@ -210,6 +218,9 @@ struct SelfCalibrationParams {
   double heading_per_m_std_rad = 0.0;
   double range_bias_std_m = 0.0;
   double range_scale_std = 0.0;
+  /// The wheels' track B of the cross term above, metres; must be the
+  /// robot's (`robot.axle_track_m`) when self-calibration is on.
+  double axle_track_m = 0.33;
 
   /// True when any entry is estimated.
   bool Enabled() const {
@@ -224,6 +235,7 @@ struct SelfCalibrationParams {
     a->Visit(MJSLAM_NVP(heading_per_m_std_rad));
     a->Visit(MJSLAM_NVP(range_bias_std_m));
     a->Visit(MJSLAM_NVP(range_scale_std));
+    a->Visit(MJSLAM_NVP(axle_track_m));
   }
   /// Every out-of-range field, keys relative to this struct.
   std::vector<ParamProblem> Validate() const;

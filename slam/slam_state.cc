@@ -115,13 +115,15 @@ void SlamState::PredictCalibrated(const MotionInput& raw, double a_m) {
   const double q_d = x_[kDistanceScale];
   const double q_th = x_[kHeadingScale];
   const double k = x_[kHeadingPerMetre];
+  const double quarter_track2 = 0.25 * raw.axle_track_m * raw.axle_track_m;
   MotionInput input = raw;
-  input.increment = Eigen::Vector2d((1.0 + q_d) * d, (1.0 + q_th) * dth + k * d);
+  input.increment = Eigen::Vector2d((1.0 + q_d) * d + k * quarter_track2 * dth,
+                                    (1.0 + q_th) * dth + k * d);
   Eigen::Matrix2d D;
-  D << 1.0 + q_d, 0.0, k, 1.0 + q_th;
+  D << 1.0 + q_d, k * quarter_track2, k, 1.0 + q_th;
   input.covariance = D * raw.covariance * D.transpose();
   Eigen::Matrix<double, 2, 3> C;
-  C << d, 0.0, 0.0, 0.0, dth, d;
+  C << d, 0.0, quarter_track2 * dth, 0.0, dth, d;
 
   Eigen::Matrix3d A;
   Eigen::Matrix<double, 3, 2> W;

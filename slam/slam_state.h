@@ -126,7 +126,8 @@ class SlamState {
   /// and n the unit vector across the mid-arc heading (position rows only).
   /// O(n): only the pose rows and columns change.
   /// With self-calibration the increment (d, dth) is first corrected to
-  /// ((1 + q_d) d, (1 + q_th) dth + k d), its covariance carried through, and
+  /// ((1 + q_d) d + k B^2 / 4 dth, (1 + q_th) dth + k d), B the input's
+  /// axle_track_m, its covariance carried through, and
   /// A extended by d pose' / d (q_d, q_th, k).
   void Predict(const MotionInput& input, double a_m);
 

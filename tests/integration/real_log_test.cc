@@ -1,8 +1,13 @@
 // Regression on the real Intel Research Lab log (../shared/data/real/ from
 // the repository root, not part of the repository): import, both filters,
 // scoring. Fails, naming the path, when the data is missing. About 3 s of CPU.
+#include <cstdio>
+#include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -78,6 +83,54 @@ TEST(RealLogTest, IntelBothFiltersAgainstOdometryAndReference) {
   EXPECT_LT(e.vs_reference[1].errors.rotation_mean_deg, 0.7 * odometry_rotation);
   EXPECT_LT(e.vs_reference[0].errors.translation_mean_m, 0.1);
   EXPECT_LT(e.vs_reference[1].errors.translation_mean_m, 0.1);
+}
+
+// The Intel log as another recorder might have written it: absolute UNIX
+// times printed with six significant digits (1.23456e+09: ten-second steps),
+// as one of the logs kept aside does. Every scan is still imported, in line
+// order, with strictly increasing times, and the import says what it did.
+// Shown to fail with the stamps read as before (ties skipped): 1 scan.
+TEST(RealLogTest, TimestampsOfLowPrecisionImportEveryScanWithAWarning) {
+  const std::string log = kDataDir + "/intel-corrected.log.gz";
+  ASSERT_TRUE(fs::exists(log)) << "the real data is missing: " << log;
+  const fs::path dir = fs::temp_directory_path() / "mjslam_real_log_test" / "low_precision";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string coarse = (dir / "intel-coarse.log").string();
+  {
+    // Rewrites each message's two timestamps (ipc and logger, the third and
+    // first field from the end) as 1.23e9 + t with "%g".
+    FILE* in = popen(("zcat '" + log + "'").c_str(), "r");
+    ASSERT_NE(in, nullptr);
+    std::ofstream out(coarse);
+    char buffer[1 << 16];
+    while (std::fgets(buffer, sizeof(buffer), in) != nullptr) {
+      std::istringstream line(buffer);
+      std::vector<std::string> fields;
+      for (std::string f; line >> f;) fields.push_back(f);
+      if (fields.size() >= 4 && (fields[0] == "ODOM" || fields[0] == "FLASER")) {
+        for (const std::size_t from_end : {1u, 3u}) {
+          std::string& field = fields[fields.size() - from_end];
+          const double t = std::atof(field.c_str());
+          char text[64];
+          std::snprintf(text, sizeof(text), "%g", t > 0.0 ? 1.23e9 + t : t);
+          field = text;
+        }
+      }
+      for (std::size_t i = 0; i < fields.size(); ++i) out << (i ? " " : "") << fields[i];
+      out << '\n';
+    }
+    pclose(in);
+  }
+  ImportOptions options;
+  options.log_path = coarse;
+  options.out_dir = (dir / "run").string();
+  const ImportReport report =
+      ImportLog(LoadRunConfig(std::string(MJSLAM_SOURCE_DIR) + "/configs/real.yaml", {}), options);
+  EXPECT_GE(report.num_scans, 900) << "scans dropped for their stamps";
+  ASSERT_FALSE(report.warnings.empty());
+  EXPECT_NE(report.warnings[0].find("timestamps of low precision"), std::string::npos)
+      << report.warnings[0];
 }
 
 }  // namespace

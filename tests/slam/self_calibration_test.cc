@@ -61,7 +61,9 @@ Eigen::VectorXd PredictedState(const Eigen::VectorXd& xi, const MotionInput& inp
   Eigen::VectorXd out = xi;
   const double d = input.increment.x();
   const double dth = input.increment.y();
-  const Eigen::Vector2d corrected((1.0 + xi[SlamState::kDistanceScale]) * d,
+  const double quarter_track2 = 0.25 * input.axle_track_m * input.axle_track_m;
+  const Eigen::Vector2d corrected((1.0 + xi[SlamState::kDistanceScale]) * d +
+                                      xi[SlamState::kHeadingPerMetre] * quarter_track2 * dth,
                                   (1.0 + xi[SlamState::kHeadingScale]) * dth +
                                       xi[SlamState::kHeadingPerMetre] * d);
   out.head<3>() = PredictPose(xi.head<3>(), corrected, kA, nullptr, nullptr,
@@ -80,6 +82,7 @@ TEST(SelfCalibrationTest, PredictionMatchesDenseJacobians) {
   input.increment = Eigen::Vector2d(0.07, -0.04);
   input.covariance = Eigen::Vector2d(2e-5, 3e-5).asDiagonal();
   input.skid_per_m_rad = 0.1;
+  input.axle_track_m = 0.33;
 
   // F = d xi' / d xi and the input's Jacobian by central differences.
   const double step = 1e-7;
