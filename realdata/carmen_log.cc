@@ -243,8 +243,8 @@ void SpreadTies(const std::string& kind, std::vector<Message>* stream, CarmenLog
   }
   log->warnings.push_back(kind + ": " + std::to_string(tied) + " of " + std::to_string(n) +
                           " messages share their timestamp with the one before (timestamps of "
-                          "low precision): their times are spread in line order between the "
-                          "neighbouring stamps");
+                          "low precision, or a clock that stalls): their times are spread in "
+                          "line order between the neighbouring stamps");
 }
 
 }  // namespace
