@@ -106,6 +106,15 @@ std::string ImportedScansPath(const std::string& run_dir) {
 
 // Reads the files, scores each trajectory on each set of relations and
 // writes summary.json: a list of the same few steps per set.
+// vs_reference_lags as {"1": [...], "10": [...], "100": [...]}.
+nlohmann::json ReferenceLagsJson(const RealEvaluation& result) {
+  nlohmann::json lags = nlohmann::json::object();
+  for (std::size_t i = 0; i < result.vs_reference_lags.size(); ++i) {
+    lags[std::to_string(RealEvaluation::kReferenceLags[i])] = ToJson(result.vs_reference_lags[i]);
+  }
+  return lags;
+}
+
 RealEvaluation EvaluateImportedRun(const std::string& run_dir) {
   const nlohmann::json manifest = rundir::ReadManifest(run_dir);
   const RunConfig config = LoadRunConfig(rundir::PathIn(run_dir, rundir::kConfigFile), {});
@@ -153,18 +162,24 @@ RealEvaluation EvaluateImportedRun(const std::string& run_dir) {
     }
   }
   if (has_reference) {
-    // Relations between consecutive scans of the reference, matched exactly.
+    // Relations between scans of the reference `lag` apart, matched exactly.
     const std::vector<TimedPose> ref = PosesOf(reference, "", {}, X_RB);
-    std::vector<Relation> consecutive;
-    for (std::size_t i = 0; i + 1 < ref.size(); ++i) {
-      consecutive.push_back({ref[i].t_s, ref[i + 1].t_s, ref[i].pose.Inverse() * ref[i + 1].pose,
-                             static_cast<int>(i + 2)});
-    }
     const realdata::RelationMatching exact{0.0, 0.0};
-    for (std::size_t i = 0; i < names.size(); ++i) {
-      result.vs_reference.push_back({names[i], realdata::ScoreRelations(
-          consecutive, PosesOf(trajectory, prefixes[i], scan_times, X_RB), exact)});
+    for (const int lag : RealEvaluation::kReferenceLags) {
+      const std::size_t step = static_cast<std::size_t>(lag);
+      std::vector<Relation> apart;
+      for (std::size_t i = 0; i + step < ref.size(); ++i) {
+        apart.push_back({ref[i].t_s, ref[i + step].t_s,
+                         ref[i].pose.Inverse() * ref[i + step].pose, static_cast<int>(i + 2)});
+      }
+      std::vector<ScoredTrajectory> scored;
+      for (std::size_t i = 0; i < names.size(); ++i) {
+        scored.push_back({names[i], realdata::ScoreRelations(
+            apart, PosesOf(trajectory, prefixes[i], scan_times, X_RB), exact)});
+      }
+      result.vs_reference_lags.push_back(scored);
     }
+    result.vs_reference = result.vs_reference_lags.front();
   }
   for (const std::string& name : rundir::FilterNames()) {
     const auto [not_psd, singular] = CovarianceDefects(trajectory, name);
@@ -184,6 +199,7 @@ RealEvaluation EvaluateImportedRun(const std::string& run_dir) {
                      {"relations_at_scans", ToJson(result.at_scans)},
                      {"relations_at_records", ToJson(result.at_records)},
                      {"vs_reference_consecutive_scans", ToJson(result.vs_reference)},
+                     {"vs_reference_scans_apart", ReferenceLagsJson(result)},
                      {"pose_covariance_not_psd_rows", result.not_positive_semidefinite},
                      {"pose_covariance_singular_rows", result.singular},
                      {"num_features", result.num_features}};

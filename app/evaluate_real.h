@@ -35,6 +35,10 @@ struct RealEvaluation {
   /// On the relations between consecutive scans of the reference trajectory
   /// (empty without one): the filters and the odometry.
   std::vector<ScoredTrajectory> vs_reference;
+  /// The same between scans kReferenceLags[i] apart (1, 10, 100), each
+  /// scan to the one that many scans later: over short and long stretches.
+  static constexpr int kReferenceLags[] = {1, 10, 100};
+  std::vector<std::vector<ScoredTrajectory>> vs_reference_lags;
   /// Relation timestamps (distinct) and how many fell on a scan.
   int relation_times = 0;
   int relation_times_at_scans = 0;

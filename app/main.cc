@@ -286,9 +286,9 @@ CLI::App* AddEvaluate(CLI::App* cli, EvaluateCommand* c) {
 // An imported log: the relation metric instead of the world's truth.
 int EvaluateImportedMain(const std::string& run_dir) {
   const RealEvaluation result = EvaluateImportedRun(run_dir);
-  auto print = [](const char* title, const std::vector<ScoredTrajectory>& scored) {
+  auto print = [](const std::string& title, const std::vector<ScoredTrajectory>& scored) {
     if (scored.empty()) return;
-    std::printf("%s\n%-10s %8s %11s %10s %11s %10s\n", title, "", "matched", "trans_mean_m",
+    std::printf("%s\n%-10s %8s %11s %10s %11s %10s\n", title.c_str(), "", "matched", "trans_mean_m",
                 "trans_std_m", "rot_mean_deg", "rot_std_deg");
     for (const ScoredTrajectory& s : scored) {
       std::printf("%-10s %8d %11.4f %10.4f %11.3f %10.3f\n", s.name.c_str(), s.errors.num_matched,
@@ -303,7 +303,12 @@ int EvaluateImportedMain(const std::string& run_dir) {
   }
   print("relations file, poses at scans:", result.at_scans);
   print("relations file, poses at every record:", result.at_records);
-  print("reference, consecutive scans:", result.vs_reference);
+  for (std::size_t i = 0; i < result.vs_reference_lags.size(); ++i) {
+    const int lag = RealEvaluation::kReferenceLags[i];
+    print(lag == 1 ? "reference, consecutive scans:"
+                   : "reference, scans " + std::to_string(lag) + " apart:",
+          result.vs_reference_lags[i]);
+  }
   for (std::size_t f = 0; f < result.num_features.size(); ++f) {
     std::printf("%s: %d features; pose covariance not positive semi-definite in %d rows, "
                 "singular in %d\n",
