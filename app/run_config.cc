@@ -53,12 +53,11 @@ std::vector<ParamProblem> RunConfig::Validate() const {
                 "slam.ekf.control_point_offset_m", slam.ekf.control_point_offset_m,
                 "robot.control_point_offset_m (" + ValueText(robot.control_point_offset_m) +
                     "): the filters must predict the robot's point h");
-  // Self-calibration's cross term needs the robot's track.
-  check.Require(!slam.ekf.self_calibration.Enabled() ||
-                    slam.ekf.self_calibration.axle_track_m == robot.axle_track_m,
-                "slam.ekf.self_calibration.axle_track_m", slam.ekf.self_calibration.axle_track_m,
+  // The odometry's wheel models need the robot's track.
+  check.Require(slam.ekf.axle_track_m == robot.axle_track_m, "slam.ekf.axle_track_m",
+                slam.ekf.axle_track_m,
                 "robot.axle_track_m (" + ValueText(robot.axle_track_m) +
-                    ") when self-calibration is on");
+                    "): the filters split the odometry into the robot's wheels");
   return check.problems();
 }
 

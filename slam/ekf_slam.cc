@@ -256,7 +256,7 @@ MotionInput EkfSlam::CheckedMotionInput(const SensorRecord& record) const {
   }
   if (record.dt_s > 0.0) input.skid_per_m_rad = params_.lateral_skid_s / record.dt_s;
   input.integration = integration_;
-  input.axle_track_m = params_.self_calibration.axle_track_m;
+  input.axle_track_m = params_.axle_track_m;
   return input;
 }
 

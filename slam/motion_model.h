@@ -44,7 +44,7 @@ struct MotionInput {
   /// How Eq. (6) is integrated over the step (EkfParams::motion_integration).
   MotionIntegration integration = MotionIntegration::kExact;
   /// The wheels' track, metres, for self-calibration's term k B^2 / 4 dth
-  /// (SelfCalibrationParams::axle_track_m); unused without it.
+  /// (EkfParams::axle_track_m); unused without it.
   double axle_track_m = 0.0;
 };
 

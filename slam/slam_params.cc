@@ -81,7 +81,6 @@ std::vector<ParamProblem> SelfCalibrationParams::Validate() const {
   check.InRange("heading_per_m_std_rad", heading_per_m_std_rad, 0.0, 1.0);
   check.InRange("range_bias_std_m", range_bias_std_m, 0.0, 1.0);
   check.InRange("range_scale_std", range_scale_std, 0.0, 0.5);
-  check.Positive("axle_track_m", axle_track_m);
   return check.problems();
 }
 
@@ -92,6 +91,7 @@ std::vector<ParamProblem> EkfParams::Validate() const {
               std::vector<std::string>(std::begin(kMotionIntegrationNames),
                                        std::end(kMotionIntegrationNames)));
   check.Positive("control_point_offset_m", control_point_offset_m);
+  check.Positive("axle_track_m", axle_track_m);
   check.Require(std::isfinite(control_point_offset_m), "control_point_offset_m",
                 control_point_offset_m, "a finite value");
   check.Positive("command_gain_v", command_gain_v);

@@ -205,7 +205,8 @@ struct OdometryNoiseParams {
 ///   q_th the heading increment's scale error;
 ///   k    the heading change per metre (rad/m): unequal wheels drive an arc,
 ///        and move forward or back when turning on the spot: with the track
-///        B, d -> (1 + q_d) d + k B^2 / 4 dth, dth -> (1 + q_th) dth + k d
+///        B (EkfParams::axle_track_m), d -> (1 + q_d) d + k B^2 / 4 dth,
+///        dth -> (1 + q_th) dth + k d
 ///        (to first order the effect of each wheel's own radius error);
 ///   b    the laser's range bias (m): every range r -> r + b;
 ///   s    the laser's range scale error: r -> (1 + s) r.
@@ -218,10 +219,6 @@ struct SelfCalibrationParams {
   double heading_per_m_std_rad = 0.0;
   double range_bias_std_m = 0.0;
   double range_scale_std = 0.0;
-  /// The wheels' track B of the cross term above, metres; must be the
-  /// robot's (`robot.axle_track_m`) when self-calibration is on.
-  double axle_track_m = 0.33;
-
   /// True when any entry is estimated.
   bool Enabled() const {
     return distance_scale_std > 0.0 || heading_scale_std > 0.0 || heading_per_m_std_rad > 0.0 ||
@@ -235,7 +232,6 @@ struct SelfCalibrationParams {
     a->Visit(MJSLAM_NVP(heading_per_m_std_rad));
     a->Visit(MJSLAM_NVP(range_bias_std_m));
     a->Visit(MJSLAM_NVP(range_scale_std));
-    a->Visit(MJSLAM_NVP(axle_track_m));
   }
   /// Every out-of-range field, keys relative to this struct.
   std::vector<ParamProblem> Validate() const;
@@ -264,6 +260,11 @@ struct EkfParams {
   /// Offset `a` of the point of control h (frame R) ahead of the wheel axle,
   /// metres (> 0). Must match the robot's (`robot.control_point_offset_m`).
   double control_point_offset_m = 0.2;
+  /// The distance between the drive wheels' contact points, metres (> 0):
+  /// self-calibration's cross term, which splits an increment into the two
+  /// wheels' travel, uses it.
+  /// Must match the robot's (`robot.axle_track_m`).
+  double axle_track_m = 0.33;
   /// Systematic part of the command following, `input: command` only: the
   /// prediction moves by (command_gain_v v dt, command_gain_w w dt) for the
   /// command (v, w) held over dt (the noise stays that of the command). The
@@ -437,6 +438,7 @@ struct EkfParams {
     a->Visit(MJSLAM_NVP(input));
     a->Visit(MJSLAM_NVP(motion_integration));
     a->Visit(MJSLAM_NVP(control_point_offset_m));
+    a->Visit(MJSLAM_NVP(axle_track_m));
     a->Visit(MJSLAM_NVP(command_gain_v));
     a->Visit(MJSLAM_NVP(command_gain_w));
     a->Visit(MJSLAM_NVP(command_lag_s));

@@ -82,6 +82,19 @@ TEST(RunConfigTest, FiltersMustPredictTheRobotsPointH) {
   }
 }
 
+TEST(RunConfigTest, FiltersSplitTheOdometryWithTheRobotsTrack) {
+  const std::string path = std::string(MJSLAM_SOURCE_DIR) + "/configs/default.yaml";
+  EXPECT_NO_THROW(
+      LoadRunConfig(path, {"robot.axle_track_m=0.34", "slam.ekf.axle_track_m=0.34"}));
+  try {
+    LoadRunConfig(path, {"robot.axle_track_m=0.34"});
+    FAIL() << "expected an error";
+  } catch (const std::exception& error) {
+    EXPECT_NE(std::string(error.what()).find("slam.ekf.axle_track_m"), std::string::npos)
+        << error.what();
+  }
+}
+
 TEST(RunConfigTest, AllProblemsReportedAtOnceWithPositions) {
   const fs::path dir = fs::temp_directory_path() / "mjslam_run_config_test";
   fs::create_directories(dir);
