@@ -64,14 +64,10 @@ Eigen::Matrix<double, 5, 5> SlamState::JointCovariance(int k) const {
   return block;
 }
 
-void SlamState::Predict(const MotionInput& input, double a_m) {
-  if (calibrated()) {
-    PredictCalibrated(input, a_m);
-    return;
-  }
+Eigen::Matrix3d SlamState::MovePose(const MotionInput& input, double a_m,
+                                    Eigen::Matrix<double, 3, 2>* W) {
   Eigen::Matrix3d A;
-  Eigen::Matrix<double, 3, 2> W;
-  x_.head<3>() = PredictPose(x_.head<3>(), input.increment, a_m, &A, &W, input.skid_per_m_rad,
+  x_.head<3>() = PredictPose(x_.head<3>(), input.increment, a_m, &A, W, input.skid_per_m_rad,
                              input.integration, input.turn_centre);
   if (jacobians_ == JacobianPoint::kFirstEstimates) {
     // FEJ (Huang et al. 2010): A = d pose' / d pose is the identity but for
@@ -82,19 +78,31 @@ void SlamState::Predict(const MotionInput& input, double a_m) {
     A(1, 2) = x_.x() - x_first_.x();
     x_first_.head<3>() = x_.head<3>();
   }
+  return A;
+}
+
+void SlamState::AddLateralSlip(const MotionInput& input, Eigen::Matrix3d* P_pp) const {
+  // Sideways slip: variance across the mid-arc heading, position only.
+  if (input.lateral_variance_m2 <= 0.0) return;
+  const double mid_heading = x_.z() - 0.5 * input.increment.y();  // x_ is already predicted
+  const Eigen::Vector2d across(-std::sin(mid_heading), std::cos(mid_heading));
+  P_pp->topLeftCorner<2, 2>().noalias() += input.lateral_variance_m2 * across * across.transpose();
+}
+
+void SlamState::Predict(const MotionInput& input, double a_m) {
+  if (calibrated()) {
+    PredictCalibrated(input, a_m);
+    return;
+  }
+  Eigen::Matrix<double, 3, 2> W;
+  const Eigen::Matrix3d A = MovePose(input, a_m, &W);
 
   // Pose block: A P_pp A^T + W Q W^T, symmetrised exactly.
   const Eigen::Matrix3d P_pp = P_.topLeftCorner<3, 3>();
   Eigen::Matrix3d P_pp_new;
   P_pp_new.noalias() = A * P_pp * A.transpose();
   P_pp_new.noalias() += W * input.covariance * W.transpose();
-  // Sideways slip: variance across the mid-arc heading, position only.
-  if (input.lateral_variance_m2 > 0.0) {
-    const double mid_heading = x_.z() - 0.5 * input.increment.y();  // x_ is already predicted
-    const Eigen::Vector2d across(-std::sin(mid_heading), std::cos(mid_heading));
-    P_pp_new.topLeftCorner<2, 2>().noalias() +=
-        input.lateral_variance_m2 * across * across.transpose();
-  }
+  AddLateralSlip(input, &P_pp_new);
   P_.topLeftCorner<3, 3>() = 0.5 * (P_pp_new + P_pp_new.transpose());
 
   // Cross terms P_fp <- P_fp A^T. A is the identity but for (0,2) and (1,2),
@@ -125,15 +133,8 @@ void SlamState::PredictCalibrated(const MotionInput& raw, double a_m) {
   Eigen::Matrix<double, 2, 3> C;
   C << d, 0.0, quarter_track2 * dth, 0.0, dth, d;
 
-  Eigen::Matrix3d A;
   Eigen::Matrix<double, 3, 2> W;
-  x_.head<3>() = PredictPose(x_.head<3>(), input.increment, a_m, &A, &W, input.skid_per_m_rad,
-                             input.integration, input.turn_centre);
-  if (jacobians_ == JacobianPoint::kFirstEstimates) {
-    A(0, 2) = -(x_.y() - x_first_.y());
-    A(1, 2) = x_.x() - x_first_.x();
-    x_first_.head<3>() = x_.head<3>();
-  }
+  const Eigen::Matrix3d A = MovePose(input, a_m, &W);
   // B = d pose' / d (q_d, q_th, k), at state indices 3-5.
   const Eigen::Matrix3d B = W * C;
 
@@ -148,12 +149,7 @@ void SlamState::PredictCalibrated(const MotionInput& raw, double a_m) {
   P_pp_new.noalias() = A * T.topRows<3>();
   P_pp_new.noalias() += B * T.middleRows<3>(kDistanceScale);
   P_pp_new.noalias() += W * input.covariance * W.transpose();
-  if (input.lateral_variance_m2 > 0.0) {
-    const double mid_heading = x_.z() - 0.5 * input.increment.y();
-    const Eigen::Vector2d across(-std::sin(mid_heading), std::cos(mid_heading));
-    P_pp_new.topLeftCorner<2, 2>().noalias() +=
-        input.lateral_variance_m2 * across * across.transpose();
-  }
+  AddLateralSlip(input, &P_pp_new);
   P_.block(3, 0, n - 3, 3) = T.bottomRows(n - 3);
   P_.block(0, 3, 3, n - 3) = T.bottomRows(n - 3).transpose();
   P_.topLeftCorner<3, 3>() = 0.5 * (P_pp_new + P_pp_new.transpose());

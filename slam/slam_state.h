@@ -199,6 +199,12 @@ class SlamState {
   Eigen::Vector2d WhitenedGain(int j, const Eigen::Matrix<double, 2, 3>& H_pose,
                                const Eigen::Matrix2d& H_feature, const Eigen::Matrix2d& E,
                                const Eigen::Matrix2d& R, const Eigen::Vector2d& nu);
+  // Moves the pose by Eq. (6) with `input` (PredictPose) and returns A =
+  // d pose' / d pose (FEJ's with kFirstEstimates, which also records the new
+  // predicted pose); *W receives d pose' / d increment.
+  Eigen::Matrix3d MovePose(const MotionInput& input, double a_m, Eigen::Matrix<double, 3, 2>* W);
+  // Adds the input's sideways slip to the new pose block *P_pp.
+  void AddLateralSlip(const MotionInput& input, Eigen::Matrix3d* P_pp) const;
   // The prediction with self-calibration (Predict).
   void PredictCalibrated(const MotionInput& input, double a_m);
   // E = [g, (z_0, 0)]: d z / d (b, s).
