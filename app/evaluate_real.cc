@@ -179,7 +179,6 @@ RealEvaluation EvaluateImportedRun(const std::string& run_dir) {
       }
       result.vs_reference_lags.push_back(scored);
     }
-    result.vs_reference = result.vs_reference_lags.front();
   }
   for (const std::string& name : rundir::FilterNames()) {
     const auto [not_psd, singular] = CovarianceDefects(trajectory, name);
@@ -198,7 +197,6 @@ RealEvaluation EvaluateImportedRun(const std::string& run_dir) {
                      {"relation_times_at_scans", result.relation_times_at_scans},
                      {"relations_at_scans", ToJson(result.at_scans)},
                      {"relations_at_records", ToJson(result.at_records)},
-                     {"vs_reference_consecutive_scans", ToJson(result.vs_reference)},
                      {"vs_reference_scans_apart", ReferenceLagsJson(result)},
                      {"pose_covariance_not_psd_rows", result.not_positive_semidefinite},
                      {"pose_covariance_singular_rows", result.singular},

@@ -32,11 +32,10 @@ struct RealEvaluation {
   /// The same, poses at every record (scans and odometry messages): the
   /// filters and the odometry.
   std::vector<ScoredTrajectory> at_records;
-  /// On the relations between consecutive scans of the reference trajectory
-  /// (empty without one): the filters and the odometry.
-  std::vector<ScoredTrajectory> vs_reference;
-  /// The same between scans kReferenceLags[i] apart (1, 10, 100), each
-  /// scan to the one that many scans later: over short and long stretches.
+  /// On the relations between scans of the reference trajectory
+  /// kReferenceLags[i] apart (1: consecutive scans; 10, 100), each scan to
+  /// the one that many scans later (empty without a reference): the filters
+  /// and the odometry, over short and long stretches.
   static constexpr int kReferenceLags[] = {1, 10, 100};
   std::vector<std::vector<ScoredTrajectory>> vs_reference_lags;
   /// Relation timestamps (distinct) and how many fell on a scan.

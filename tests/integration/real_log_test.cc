@@ -77,12 +77,14 @@ TEST(RealLogTest, IntelBothFiltersAgainstOdometryAndReference) {
   // odometry's against the reference: at most 0.7 of its rotational error
   // (measured 0.40 classical, 0.46 selective); the translational errors
   // are of the odometry's size (0.065 and 0.068 m against 0.057 m).
-  ASSERT_EQ(e.vs_reference.size(), 3u);
-  const double odometry_rotation = e.vs_reference[2].errors.rotation_mean_deg;
-  EXPECT_LT(e.vs_reference[0].errors.rotation_mean_deg, 0.7 * odometry_rotation);
-  EXPECT_LT(e.vs_reference[1].errors.rotation_mean_deg, 0.7 * odometry_rotation);
-  EXPECT_LT(e.vs_reference[0].errors.translation_mean_m, 0.1);
-  EXPECT_LT(e.vs_reference[1].errors.translation_mean_m, 0.1);
+  ASSERT_EQ(e.vs_reference_lags.size(), 3u);
+  const std::vector<ScoredTrajectory>& consecutive = e.vs_reference_lags[0];
+  ASSERT_EQ(consecutive.size(), 3u);
+  const double odometry_rotation = consecutive[2].errors.rotation_mean_deg;
+  EXPECT_LT(consecutive[0].errors.rotation_mean_deg, 0.7 * odometry_rotation);
+  EXPECT_LT(consecutive[1].errors.rotation_mean_deg, 0.7 * odometry_rotation);
+  EXPECT_LT(consecutive[0].errors.translation_mean_m, 0.1);
+  EXPECT_LT(consecutive[1].errors.translation_mean_m, 0.1);
 }
 
 // The Intel log as another recorder might have written it: absolute UNIX
