@@ -74,25 +74,24 @@ std::string Absolute(const std::string& path, const std::filesystem::path& base)
   return p.lexically_normal().string();
 }
 
-// True when an override sets `key`.
-bool Overrides(const std::vector<std::string>& overrides, const std::string& key) {
-  for (const std::string& text : overrides) {
-    if (text.rfind(key + "=", 0) == 0) return true;
-  }
-  return false;
+// The folder a relative path of `key` is relative to: the working folder for
+// a `--set` option, else the folder of the config file that set it (a base
+// file's paths are relative to the base).
+std::filesystem::path FolderOf(const config::internal::MarkTable& marks, const std::string& key,
+                               const std::string& path) {
+  const std::string source = marks.Find(key, path).source;
+  if (source.rfind("--set ", 0) == 0) return std::filesystem::current_path();
+  return std::filesystem::absolute(std::filesystem::path(source)).parent_path();
 }
 
 }  // namespace
 
 RunConfig LoadRunConfig(const std::string& path, const std::vector<std::string>& overrides) {
-  RunConfig config = config::LoadConfigFile<RunConfig>(path, overrides);
-  const std::filesystem::path config_dir =
-      std::filesystem::absolute(std::filesystem::path(path)).parent_path();
-  const std::filesystem::path cwd = std::filesystem::current_path();
-  config.run.world =
-      Absolute(config.run.world, Overrides(overrides, "run.world") ? cwd : config_dir);
-  config.run.robot_model = Absolute(
-      config.run.robot_model, Overrides(overrides, "run.robot_model") ? cwd : config_dir);
+  config::internal::MarkTable marks;
+  RunConfig config = config::LoadConfigFile<RunConfig>(path, overrides, &marks);
+  config.run.world = Absolute(config.run.world, FolderOf(marks, "run.world", path));
+  config.run.robot_model =
+      Absolute(config.run.robot_model, FolderOf(marks, "run.robot_model", path));
   return config;
 }
 

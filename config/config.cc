@@ -50,9 +50,19 @@ void Remark(ConfigNode* node, const SourceMark& mark) {
   }
 }
 
-// Maps merge key by key; anything else replaces.
+// The scalar of a map's "kind" entry, or "" when it has none.
+std::string KindOf(const ConfigNode& map) {
+  for (const ConfigEntry& entry : map.entries) {
+    if (entry.key == "kind" && entry.value.kind == Kind::kScalar) return entry.value.scalar;
+  }
+  return {};
+}
+
+// Maps merge key by key; anything else replaces, and so does a map of
+// another "kind".
 void Merge(ConfigNode* target, const ConfigNode& value) {
-  if (target->kind != Kind::kMap || value.kind != Kind::kMap) {
+  if (target->kind != Kind::kMap || value.kind != Kind::kMap ||
+      (!KindOf(value).empty() && KindOf(value) != KindOf(*target))) {
     *target = value;
     return;
   }
@@ -102,6 +112,85 @@ ConfigNode ParseRoot(const std::string& text, const std::string& source,
                          "expected a map of keys at the top level (got " + NodeText(root) + ")"});
   }
   return MapNode(root.mark);
+}
+
+namespace {
+
+// Adds to `target` every entry of `base` it lacks, through nested maps. A map
+// whose "kind" differs from the base's is a different choice: the base's
+// entries of the other kind are not mixed in.
+void Underlay(ConfigNode* target, const ConfigNode& base) {
+  if (target->kind != Kind::kMap || base.kind != Kind::kMap) return;
+  if (KindOf(*target) != KindOf(base) && !KindOf(*target).empty()) return;
+  for (const ConfigEntry& entry : base.entries) {
+    if (ConfigEntry* existing = FindEntry(target, entry.key)) {
+      Underlay(&existing->value, entry.value);
+    } else {
+      target->entries.push_back(entry);
+    }
+  }
+}
+
+// Reads `source`'s text, then its base chain; `chain` holds the files being
+// read (to refuse a cycle).
+ConfigNode ReadChain(const std::string& text, const std::string& source,
+                     std::vector<std::string>* chain, std::vector<ConfigProblem>* problems) {
+  constexpr std::size_t kMaxDepth = 16;
+  ConfigNode root = ParseRoot(text, source, problems);
+  const auto base_entry = std::find_if(root.entries.begin(), root.entries.end(),
+                                       [](const ConfigEntry& e) { return e.key == kBaseKey; });
+  if (base_entry == root.entries.end()) return root;
+  const ConfigEntry entry = *base_entry;
+  root.entries.erase(base_entry);
+  if (FindEntry(&root, kBaseKey) != nullptr) {
+    problems->push_back({entry.key_mark, kBaseKey, "duplicate key"});
+  }
+  if (entry.value.kind != Kind::kScalar || entry.value.scalar.empty()) {
+    problems->push_back({entry.value.mark, kBaseKey,
+                         "expected the path of a config file (got " + NodeText(entry.value) + ")"});
+    return root;
+  }
+  namespace fs = std::filesystem;
+  fs::path path(entry.value.scalar);
+  if (path.is_relative()) path = fs::path(source).parent_path() / path;
+  const std::string name = path.lexically_normal().string();
+  std::error_code ec;
+  const fs::path canonical = fs::weakly_canonical(path, ec);
+  const std::string key = ec ? name : canonical.string();
+  if (std::find(chain->begin(), chain->end(), key) != chain->end()) {
+    problems->push_back({entry.value.mark, kBaseKey,
+                         "'" + name + "' is this file or one of its bases (a cycle)"});
+    return root;
+  }
+  if (chain->size() >= kMaxDepth) {
+    problems->push_back({entry.value.mark, kBaseKey,
+                         "more than " + std::to_string(kMaxDepth) + " bases in a chain"});
+    return root;
+  }
+  std::string base_text;
+  try {
+    base_text = ReadTextFile(name);
+  } catch (const ConfigError& error) {
+    problems->push_back({entry.value.mark, kBaseKey, error.problems().front().message + ": '" +
+                                                         name + "'"});
+    return root;
+  }
+  chain->push_back(key);
+  const ConfigNode base = ReadChain(base_text, name, chain, problems);
+  chain->pop_back();
+  Underlay(&root, base);
+  return root;
+}
+
+}  // namespace
+
+ConfigNode ReadWithBases(const std::string& text, const std::string& source,
+                         std::vector<ConfigProblem>* problems) {
+  std::vector<std::string> chain;
+  std::error_code ec;
+  const std::filesystem::path canonical = std::filesystem::weakly_canonical(source, ec);
+  chain.push_back(ec ? source : canonical.string());
+  return ReadChain(text, source, &chain, problems);
 }
 
 void ApplyOverrides(const std::vector<std::string>& overrides, ConfigNode* root,

@@ -26,6 +26,18 @@ std::string ReadTextFile(const std::string& path);
 ConfigNode ParseRoot(const std::string& text, const std::string& source,
                      std::vector<ConfigProblem>* problems);
 
+/// The top-level key that names a config's base file.
+inline constexpr const char* kBaseKey = "base";
+
+/// ParseRoot, then, when the top level has `base: PATH` (relative to the
+/// directory of `source`), the base file read the same way (its own base
+/// first) with this text laid over it: maps merge key by key, anything else
+/// replaces, and a map whose `kind` differs from the base's replaces the
+/// base's whole. Every node keeps the mark of the file that set it. A missing
+/// or unreadable base, a cycle or a chain of more than 16 files is a problem.
+ConfigNode ReadWithBases(const std::string& text, const std::string& source,
+                         std::vector<ConfigProblem>* problems);
+
 /// Applies each "dotted.key=value" to the map `root`, in order (a later
 /// override of the same key wins). The value text is parsed as YAML; a map
 /// value is merged into an existing map key by key, any other value replaces
@@ -59,15 +71,18 @@ void SortProblems(const std::string& source, std::vector<ConfigProblem>* problem
 /// unknown keys (with the known keys of that level), duplicate keys, wrong
 /// types, out-of-range values, bad `--set` options. An empty text gives the
 /// defaults (validated).
+/// `marks`, when given, receives where each key was set (a file's mark, a
+/// `--set` option's, or `source_name` alone for a default).
 template <typename T>
 T LoadConfigString(const std::string& yaml_text, const std::string& source_name,
-                   const std::vector<std::string>& overrides = {}) {
+                   const std::vector<std::string>& overrides = {},
+                   internal::MarkTable* marks_out = nullptr) {
   static_assert(internal::HasSerialize<T>::value,
                 "T must have template <typename Archive> void Serialize(Archive*)");
   std::vector<ConfigProblem> problems;
 
   // Parse the text, then lay the overrides over the tree.
-  ConfigNode root = internal::ParseRoot(yaml_text, source_name, &problems);
+  ConfigNode root = internal::ReadWithBases(yaml_text, source_name, &problems);
   internal::ApplyOverrides(overrides, &root, &problems);
 
   // Read the tree into a default-constructed T, recording where each key was set.
@@ -86,14 +101,16 @@ T LoadConfigString(const std::string& yaml_text, const std::string& source_name,
     internal::SortProblems(source_name, &problems);
     throw ConfigError(std::move(problems));
   }
+  if (marks_out != nullptr) *marks_out = std::move(marks);
   return params;
 }
 
 /// LoadConfigString on the text of the file at `path` (named `path` in
 /// messages). Throws ConfigError also when the file is missing or unreadable.
 template <typename T>
-T LoadConfigFile(const std::string& path, const std::vector<std::string>& overrides = {}) {
-  return LoadConfigString<T>(internal::ReadTextFile(path), path, overrides);
+T LoadConfigFile(const std::string& path, const std::vector<std::string>& overrides = {},
+                 internal::MarkTable* marks_out = nullptr) {
+  return LoadConfigString<T>(internal::ReadTextFile(path), path, overrides, marks_out);
 }
 
 /// Block-style YAML of every field of `params` (nested maps for structs),

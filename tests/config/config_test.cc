@@ -431,5 +431,98 @@ TEST(ConfigTest, LoadsFileAndNamesItInMessages) {
   std::filesystem::remove(path);
 }
 
+// Writes `text` to `name` in a fresh folder of its own under the test's
+// temporary folder and returns the path.
+std::string WriteFile(const std::string& folder, const std::string& name,
+                      const std::string& text) {
+  const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / folder;
+  std::filesystem::create_directories(dir);
+  const std::string path = (dir / name).string();
+  std::ofstream(path) << text;
+  return path;
+}
+
+TEST(ConfigBaseTest, FileStatesWhatDiffersFromItsBaseChain) {
+  WriteFile("bases", "a.yaml", "rate_hz: 4\nlaser:\n  beam_count: 5\n  mode: noisy\n");
+  WriteFile("bases", "b.yaml", "base: a.yaml\nlaser:\n  beam_count: 7\n");
+  const std::string c = WriteFile("bases", "c.yaml", "base: b.yaml\nmin_range_m: 0.5\n");
+  const ToyParams params = LoadConfigFile<ToyParams>(c, {"laser.seed=3"});
+  EXPECT_EQ(params.rate_hz, 4.0);               // from a.yaml
+  EXPECT_EQ(params.laser.mode, "noisy");        // a.yaml, under b.yaml's laser map
+  EXPECT_EQ(params.laser.beam_count, 7);        // b.yaml over a.yaml
+  EXPECT_EQ(params.min_range_m, 0.5);           // c.yaml
+  EXPECT_EQ(params.laser.seed, 3u);             // --set over all
+  EXPECT_EQ(params.max_range_m, 30.0);          // the default
+}
+
+TEST(ConfigBaseTest, ProblemsNameTheFileAndLineThatSetTheValue) {
+  const std::string a = WriteFile("bases_marks", "a.yaml", "rate_hz: 4\nlaser:\n  beam_count: -5\n");
+  const std::string b = WriteFile("bases_marks", "b.yaml", "base: a.yaml\nrate_hz: 2\n");
+  try {
+    LoadConfigFile<ToyParams>(b);
+    FAIL() << "no ConfigError";
+  } catch (const ConfigError& error) {
+    EXPECT_EQ(std::string(error.what()),
+              a + ":3:15: laser.beam_count: expected a value > 0 (got -5)");
+  }
+  internal::MarkTable marks;
+  WriteFile("bases_marks", "a.yaml", "rate_hz: 4\n");
+  LoadConfigFile<ToyParams>(b, {}, &marks);
+  EXPECT_EQ(marks.Find("rate_hz", b).source, b);
+  EXPECT_EQ(marks.Find("max_range_m", b).source, b);  // a default names the file read
+}
+
+TEST(ConfigBaseTest, MissingBaseCycleAndBadValueAreProblemsOnTheBaseLine) {
+  const std::string missing = WriteFile("bases_bad", "m.yaml", "rate_hz: 2\nbase: none.yaml\n");
+  EXPECT_TRUE(Contains(
+      [&] {
+        try {
+          LoadConfigFile<ToyParams>(missing);
+        } catch (const ConfigError& error) {
+          return std::string(error.what());
+        }
+        return std::string();
+      }(),
+      missing + ":2:7: base: cannot read config file (No such file or directory): '"));
+
+  WriteFile("bases_bad", "x.yaml", "base: y.yaml\n");
+  const std::string y = WriteFile("bases_bad", "y.yaml", "base: ./x.yaml\n");
+  try {
+    LoadConfigFile<ToyParams>(y);
+    FAIL() << "no ConfigError for a cycle";
+  } catch (const ConfigError& error) {
+    EXPECT_TRUE(Contains(error.what(), "is this file or one of its bases (a cycle)"));
+  }
+  EXPECT_TRUE(Contains(ErrorOf("base: [a, b]\n"), "x.yaml:1:7: base: expected the path of a config file"));
+}
+
+TEST(ConfigBaseTest, MapOfAnotherKindReplacesTheBasesMap) {
+  WriteFile("bases_kind", "a.yaml", "model:\n  kind: one\n  p: 1\n  q: 2\n");
+  const std::string same =
+      WriteFile("bases_kind", "same.yaml", "base: a.yaml\nmodel:\n  p: 3\n");
+  const std::string other =
+      WriteFile("bases_kind", "other.yaml", "base: a.yaml\nmodel:\n  kind: two\n  r: 4\n");
+  const auto keys = [](const std::string& path) {
+    std::vector<ConfigProblem> problems;
+    const ConfigNode root =
+        internal::ReadWithBases(internal::ReadTextFile(path), path, &problems);
+    EXPECT_TRUE(problems.empty());
+    std::string text;
+    for (const ConfigEntry& entry : root.entries.at(0).value.entries) {
+      text += entry.key + "=" + entry.value.scalar + " ";
+    }
+    return text;
+  };
+  EXPECT_EQ(keys(same), "p=3 kind=one q=2 ");
+  EXPECT_EQ(keys(other), "kind=two r=4 ");
+  // The same rule for --set: a map of another kind replaces.
+  std::vector<ConfigProblem> problems;
+  ConfigNode root = internal::ReadWithBases(internal::ReadTextFile(same), same, &problems);
+  internal::ApplyOverrides({"model={kind: two, r: 5}"}, &root, &problems);
+  ASSERT_TRUE(problems.empty());
+  ASSERT_EQ(root.entries.at(0).value.entries.size(), 2u);
+  EXPECT_EQ(root.entries.at(0).value.entries[1].value.scalar, "5");
+}
+
 }  // namespace
 }  // namespace mjslam::config
