@@ -18,8 +18,17 @@ import math
 import os
 import sys
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from calibrate_noise import axle_motion  # noqa: E402
+
+
+def axle_motion(x0, y0, th0, x1, y1, th1, offset):
+    """(chord, dth, lateral) of the axle centre (`offset` metres behind R)
+    between two poses of R: its motion along and across the mid-arc heading,
+    and the heading change."""
+    dx = (x1 - offset * math.cos(th1)) - (x0 - offset * math.cos(th0))
+    dy = (y1 - offset * math.sin(th1)) - (y0 - offset * math.sin(th0))
+    dth = math.remainder(th1 - th0, 2.0 * math.pi)
+    mid = th0 + 0.5 * dth
+    return dx * math.cos(mid) + dy * math.sin(mid), dth, -dx * math.sin(mid) + dy * math.cos(mid)
 
 
 def steps(path, offset):

@@ -228,32 +228,10 @@ MotionInput EkfSlam::CheckedMotionInput(const SensorRecord& record) const {
   } else {
     RequireFinite(record.command.v_mps, "record.command.v_mps");
     RequireFinite(record.command.w_radps, "record.command.w_radps");
-    const RampStep ramp = RampCommand(ramped_command_, record.command, record.dt_s,
-                                      params_.command_ramp_mps2, params_.command_ramp_radps2);
-    const Twist2 followed =
-        FollowCommand(followed_command_, ramp.mean, record.dt_s, params_.Following());
-    input = CommandInput(record.command, record.dt_s, params_.command_noise, previous_command_,
-                         params_.command_gain_v, params_.command_gain_w, &followed,
-                         previous_change_);
+    input = CommandInput(record.command, record.dt_s, params_.command_noise, previous_command_);
   }
-  const double speed_mps = record.dt_s > 0.0 ? std::abs(input.increment.x()) / record.dt_s : 0.0;
-  const double slip_per_rad = std::hypot(params_.lateral_slip_std_m_per_rad,
-                                         params_.lateral_slip_std_m_per_rad_per_mps * speed_mps);
-  const double slip_std = slip_per_rad * std::abs(input.increment.y());
+  const double slip_std = params_.lateral_slip_std_m_per_rad * std::abs(input.increment.y());
   input.lateral_variance_m2 = slip_std * slip_std;
-  if (params_.input != "odometry") {
-    const double change_std = params_.lateral_slip_std_m_per_radps_change *
-                              std::abs(record.command.w_radps - previous_command_.w_radps);
-    input.lateral_variance_m2 += change_std * change_std;
-    // On the spot the robot turns about a point beside its axle, at a
-    // distance proportional to the commanded turn rate (departure 24).
-    if (record.command.v_mps == 0.0 && previous_command_.v_mps == 0.0) {
-      input.turn_centre.offset_m =
-          params_.turn_centre_offset_m_per_radps * record.command.w_radps;
-      input.turn_centre.previous_offset_m =
-          params_.turn_centre_offset_m_per_radps * previous_command_.w_radps;
-    }
-  }
   if (record.dt_s > 0.0) input.skid_per_m_rad = params_.lateral_skid_s / record.dt_s;
   input.integration = integration_;
   input.axle_track_m = params_.axle_track_m;
@@ -265,12 +243,6 @@ void EkfSlam::Predict(const SensorRecord& record, const MotionInput& input) {
     X_OR_previous_ = record.X_OR;
     has_odometry_ = true;
   }
-  const RampStep ramp = RampCommand(ramped_command_, record.command, record.dt_s,
-                                    params_.command_ramp_mps2, params_.command_ramp_radps2);
-  ramped_command_ = ramp.end;
-  followed_command_ = FollowCommand(followed_command_, ramp.mean, record.dt_s, params_.Following());
-  previous_change_ = Twist2{record.command.v_mps - previous_command_.v_mps,
-                            record.command.w_radps - previous_command_.w_radps};
   previous_command_ = record.command;
   state_.Predict(input, params_.control_point_offset_m);
 }

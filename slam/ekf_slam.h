@@ -198,9 +198,6 @@ class EkfSlam {
   Pose2 X_OR_previous_;
   bool has_odometry_ = false;  // whether X_OR_previous_ holds a record's pose
   Twist2 previous_command_;    // the command of the record before (zero at first)
-  Twist2 previous_change_;     // previous_command_ less the command before it (zero at first)
-  Twist2 followed_command_;    // the speeds the lag model moved at (zero at first: at rest)
-  Twist2 ramped_command_;      // the robot's ramped set point (zero at first)
   std::vector<FeatureInfo> info_;
   int next_id_ = 0;
 };

@@ -42,21 +42,6 @@ std::vector<ParamProblem> CommandNoiseParams::Validate() const {
   check.NonNegative("w_noise_std_radps", w_noise_std_radps);
   check.NonNegative("w_noise_fraction", w_noise_fraction);
   check.NonNegative("change_noise_fraction", change_noise_fraction);
-  check.NonNegative("settle_noise_fraction", settle_noise_fraction);
-  check.NonNegative("lag_noise_fraction", lag_noise_fraction);
-  check.NonNegative("turn_v_noise_m_per_rad", turn_v_noise_m_per_rad);
-  check.NonNegative("speed_w_noise_rad_per_m", speed_w_noise_rad_per_m);
-  check.NonNegative("calibrated_change_v_mps", calibrated_change_v_mps);
-  check.NonNegative("calibrated_change_w_radps", calibrated_change_w_radps);
-  check.NonNegative("beyond_change_noise_fraction", beyond_change_noise_fraction);
-  if (beyond_change_noise_fraction > 0.0) {
-    check.Require(calibrated_change_v_mps > 0.0, "calibrated_change_v_mps",
-                  calibrated_change_v_mps, "a value > 0 when beyond_change_noise_fraction > 0");
-    check.Require(calibrated_change_w_radps > 0.0, "calibrated_change_w_radps",
-                  calibrated_change_w_radps, "a value > 0 when beyond_change_noise_fraction > 0");
-  }
-  check.Positive("v_noise_scale", v_noise_scale);
-  check.Positive("w_noise_scale", w_noise_scale);
   // A zero constant part would make a stopped robot's prediction exact.
   check.Require(v_noise_std_mps > 0.0 || w_noise_std_radps > 0.0, "v_noise_std_mps",
                 v_noise_std_mps, "a value > 0 when w_noise_std_radps is 0");
@@ -94,25 +79,10 @@ std::vector<ParamProblem> EkfParams::Validate() const {
   check.Positive("axle_track_m", axle_track_m);
   check.Require(std::isfinite(control_point_offset_m), "control_point_offset_m",
                 control_point_offset_m, "a finite value");
-  check.Positive("command_gain_v", command_gain_v);
-  check.Require(std::isfinite(command_gain_v), "command_gain_v", command_gain_v, "a finite value");
-  check.Positive("command_gain_w", command_gain_w);
-  check.Require(std::isfinite(command_gain_w), "command_gain_w", command_gain_w, "a finite value");
-  check.NonNegative("command_lag_s", command_lag_s);
-  check.Require(std::isfinite(command_lag_s), "command_lag_s", command_lag_s, "a finite value");
-  check.Require(std::isfinite(command_lag_w_s), "command_lag_w_s", command_lag_w_s,
-                "a finite value (negative: command_lag_s)");
-  check.NonNegative("command_max_accel_mps2", command_max_accel_mps2);
-  check.NonNegative("command_ramp_mps2", command_ramp_mps2);
-  check.NonNegative("command_ramp_radps2", command_ramp_radps2);
   check.Merge("command_noise", command_noise.Validate());
   check.Merge("odometry_noise", odometry_noise.Validate());
   check.Merge("self_calibration", self_calibration.Validate());
   check.NonNegative("lateral_slip_std_m_per_rad", lateral_slip_std_m_per_rad);
-  check.NonNegative("lateral_slip_std_m_per_rad_per_mps", lateral_slip_std_m_per_rad_per_mps);
-  check.NonNegative("lateral_slip_std_m_per_radps_change", lateral_slip_std_m_per_radps_change);
-  check.Require(std::isfinite(turn_centre_offset_m_per_radps), "turn_centre_offset_m_per_radps",
-                turn_centre_offset_m_per_radps, "a finite value");
   check.NonNegative("lateral_skid_s", lateral_skid_s);
   check.OneOf("jacobians", jacobians,
               std::vector<std::string>(std::begin(kJacobianPointNames),

@@ -69,9 +69,8 @@ SelectionPolicy SelectionPolicyFromName(const std::string& name);
 /// command`). The robot's real motion differs from the command through the
 /// wheel dynamics (lag, acceleration limits, slip), so these must cover that
 /// difference, not only actuator noise. One standard deviation each, held
-/// over the record's `dt_s`: sigma_v = v_noise_scale (v_noise_std_mps +
-/// v_noise_fraction |v| + change_noise_fraction |v - v_prev|), likewise
-/// sigma_w. Serialized under `slam.ekf.command_noise.*`.
+/// over the record's `dt_s`: sigma_v = v_noise_std_mps + v_noise_fraction |v|
+/// + change_noise_fraction |v - v_prev|, likewise sigma_w. Serialized under `slam.ekf.command_noise.*`.
 struct CommandNoiseParams {
   /// Constant part of the linear-velocity noise, m/s.
   double v_noise_std_mps = 0.03;
@@ -86,50 +85,6 @@ struct CommandNoiseParams {
   /// wheels follow a step in the command with a lag, so the motion over the
   /// period lies between the two commands.
   double change_noise_fraction = 0.5;
-  /// Part of the noise proportional to the change of the command one record
-  /// earlier (|v_prev - v_prev2|, likewise w; dimensionless): the simulated
-  /// wheels are still settling in the period after a step of the command,
-  /// which the first-order lag (EkfParams::command_lag_s) does not follow
-  /// (docs/method.md, departure 22). 0: no such term.
-  double settle_noise_fraction = 0.0;
-  /// Part of the noise proportional to the gap between the command and the
-  /// speeds the wheels follow it with (|v - v_followed|, likewise w;
-  /// dimensionless; EkfParams::command_lag_s): the wheels catching up after a
-  /// change, a start or a stop move in ways the first-order lag follows only
-  /// roughly (docs/method.md, departure 25). 0 (the default): no such term.
-  double lag_noise_fraction = 0.0;
-  /// Part of the speed noise sigma_v proportional to the turn rate |w|
-  /// (m/s per rad/s): each wheel's own variation moves a turning robot
-  /// forward or back, even on the spot (docs/method.md, departure 26).
-  /// 0 (the default): no such term.
-  double turn_v_noise_m_per_rad = 0.0;
-  /// Part of the turn-rate noise sigma_w proportional to the speed |v|
-  /// (rad/s per m/s): each wheel's own variation turns a robot that drives
-  /// straight (departure 26). 0 (the default): no such term.
-  double speed_w_noise_rad_per_m = 0.0;
-  /// The largest change of the commanded speed and turn rate from one record
-  /// to the next that the noise above was calibrated on, m/s and rad/s
-  /// (scripts/calibrate_noise.py writes them): beyond them the drive meets
-  /// its torque limit and follows far more slowly than the lag says
-  /// (docs/method.md, departure 29). Used only with
-  /// `beyond_change_noise_fraction` > 0, and then both must be > 0.
-  double calibrated_change_v_mps = 0.0;
-  double calibrated_change_w_radps = 0.0;
-  /// Noise of a change beyond that range (dimensionless): with x the
-  /// relative excess of this record's change and of the one before,
-  /// x = sum of max(0, |change| - calibrated) / calibrated over v and w,
-  /// sigma_v grows by beyond_change_noise_fraction calibrated_change_v_mps x
-  /// and sigma_w by beyond_change_noise_fraction calibrated_change_w_radps x
-  /// (one wheel held at its torque limit slows the speed and the turn
-  /// alike). 0 (the default): no such term.
-  double beyond_change_noise_fraction = 0.0;
-  /// Factor on the whole of sigma_v (dimensionless, > 0): the fitted shape
-  /// above kept, its size set against the filters' consistency on training
-  /// runs (scripts/calibrate_noise.py --nees; docs/method.md, "Calibrating the
-  /// process noise"). 1: the terms above as they are.
-  double v_noise_scale = 1.0;
-  /// Factor on the whole of sigma_w; see `v_noise_scale`.
-  double w_noise_scale = 1.0;
 
   template <typename Archive>
   void Serialize(Archive* a) {
@@ -138,15 +93,6 @@ struct CommandNoiseParams {
     a->Visit(MJSLAM_NVP(w_noise_std_radps));
     a->Visit(MJSLAM_NVP(w_noise_fraction));
     a->Visit(MJSLAM_NVP(change_noise_fraction));
-    a->Visit(MJSLAM_NVP(settle_noise_fraction));
-    a->Visit(MJSLAM_NVP(lag_noise_fraction));
-    a->Visit(MJSLAM_NVP(turn_v_noise_m_per_rad));
-    a->Visit(MJSLAM_NVP(speed_w_noise_rad_per_m));
-    a->Visit(MJSLAM_NVP(calibrated_change_v_mps));
-    a->Visit(MJSLAM_NVP(calibrated_change_w_radps));
-    a->Visit(MJSLAM_NVP(beyond_change_noise_fraction));
-    a->Visit(MJSLAM_NVP(v_noise_scale));
-    a->Visit(MJSLAM_NVP(w_noise_scale));
   }
   /// Every out-of-range field, keys relative to this struct.
   std::vector<ParamProblem> Validate() const;
@@ -238,14 +184,6 @@ struct SelfCalibrationParams {
   void ValidateOrThrow() const { ThrowIfProblems(Validate()); }
 };
 
-/// How the wheels follow the command (EkfParams::command_lag_s,
-/// command_lag_w_s, command_max_accel_mps2; departures 21 and 27).
-struct CommandFollowing {
-  double lag_v_s = 0.0;         ///< the speed's lag time constant, s (>= 0; 0: none)
-  double lag_w_s = 0.0;         ///< the turn rate's, s (>= 0; 0: none)
-  double max_accel_mps2 = 0.0;  ///< the speed's largest change per second (> 0), 0: no limit
-};
-
 /// Parameters of the EKF-SLAM filters (slam/README.md, "The filter").
 /// Serialized under `slam.ekf.*`.
 struct EkfParams {
@@ -265,46 +203,6 @@ struct EkfParams {
   /// wheels' travel, uses it.
   /// Must match the robot's (`robot.axle_track_m`).
   double axle_track_m = 0.33;
-  /// Systematic part of the command following, `input: command` only: the
-  /// prediction moves by (command_gain_v v dt, command_gain_w w dt) for the
-  /// command (v, w) held over dt (the noise stays that of the command). The
-  /// mean ratio of the robot's true speeds to its commands, identified by
-  /// scripts/calibrate_noise.py (docs/method.md, "Calibrating the process
-  /// noise"). 1: the command as it is (the paper's).
-  double command_gain_v = 1.0;
-  /// Same for the turn rate.
-  double command_gain_w = 1.0;
-  /// Time constant of the wheels' first-order lag behind the command,
-  /// seconds (>= 0), `input: command` only: the prediction moves at the
-  /// speeds FollowCommand gives (the robot starts at rest), not at the
-  /// command held. Identified by scripts/calibrate_noise.py. 0: the command
-  /// held over the step (the paper's).
-  double command_lag_s = 0.0;
-  /// The turn rate's own lag time constant, seconds (>= 0), when the wheels
-  /// follow a change of the turn rate otherwise than one of the speed
-  /// (departure 27); negative (the default): command_lag_s, the one lag of
-  /// both. Identified by scripts/calibrate_noise.py --drive-lag.
-  double command_lag_w_s = -1.0;
-  /// The speed's largest change per second the prediction follows, m/s^2
-  /// (> 0), on top of the lag: a large step of the command is followed at
-  /// this bounded acceleration (the drive's torque limit), a small one
-  /// through the lag (departure 27). 0 (the default): no limit.
-  /// Identified by scripts/calibrate_noise.py --drive-lag.
-  double command_max_accel_mps2 = 0.0;
-  /// The robot's own ramp of its set points toward each new command, m/s^2
-  /// (>= 0), `input: command` only: the prediction follows, through the
-  /// lag, the ramped set point's mean over each step (RampCommand; the
-  /// simulator's sim.command_accel_mps2; departure 28). 0 (the default, the
-  /// paper's): the command itself. Known from the robot's controller, not
-  /// fitted (scripts/calibrate_noise.py --ramp takes it).
-  double command_ramp_mps2 = 0.0;
-  /// Same for the turn rate, rad/s^2 (sim.command_accel_radps2).
-  double command_ramp_radps2 = 0.0;
-  /// The lags and the limit above as FollowCommand takes them.
-  CommandFollowing Following() const {
-    return CommandFollowing{command_lag_s, command_lag_w_s < 0.0 ? command_lag_s : command_lag_w_s,
-                            command_max_accel_mps2};
-  }
   /// Input noise when `input` is "command".
   CommandNoiseParams command_noise;
   /// Input noise when `input` is "odometry".
@@ -316,32 +214,6 @@ struct EkfParams {
   /// prediction adds (k |dth|)^2 of variance across the mid-arc heading
   /// (docs/method.md, departure 10).
   double lateral_slip_std_m_per_rad = 0.005;
-  /// Growth of that slip with the speed, metres per radian per (m/s): the
-  /// slip per radian turned is hypot(lateral_slip_std_m_per_rad, this |v|),
-  /// v = d / dt of the step's increment (0 when dt = 0), so that a turn on
-  /// the spot and a turn while driving each get their own spread. 0 (the
-  /// default): one value for all turns (docs/method.md, departure 23).
-  double lateral_slip_std_m_per_rad_per_mps = 0.0;
-  /// Sideways slip of R at a change of the turn-rate command, one standard
-  /// deviation, metres per rad/s of change, with the command input only:
-  /// the prediction adds (this |w - w_previous|)^2 of variance across the
-  /// mid-arc heading, w_previous the command of the record before (a robot
-  /// that starts or stops turning jolts sideways). 0 (the default): none
-  /// (docs/method.md, departure 23).
-  double lateral_slip_std_m_per_radps_change = 0.0;
-  /// The point a robot turning on the spot turns about, beside its axle,
-  /// metres per rad/s of the commanded turn rate (signed), with the command
-  /// input only: when the command and the one of the record before both
-  /// have v = 0, the axle lies this times w to the left of the point it
-  /// turns about (for a positive value and w > 0: the point on the right, the
-  /// outside of the turn), the point fixed in W over the step
-  /// (slam::TurnCentre). Its two consequences: a sideways shift of the axle
-  /// by this (w - w_previous) when the turn rate changes and, while it is
-  /// held, the axle circling the point (for a positive value a backward
-  /// creep of about this w^2 dt per step). The same in every run, so a mean
-  /// motion, not a spread. 0 (the default): the turn about the axle
-  /// (docs/method.md, departure 24).
-  double turn_centre_offset_m_per_radps = 0.0;
   /// Sideways skid of the axle centre in turns, seconds: Eq. (6) has no
   /// sideways motion, but tyres skid to the outside of a turn at a speed
   /// proportional to the centripetal acceleration, c v w. The prediction
@@ -439,20 +311,10 @@ struct EkfParams {
     a->Visit(MJSLAM_NVP(motion_integration));
     a->Visit(MJSLAM_NVP(control_point_offset_m));
     a->Visit(MJSLAM_NVP(axle_track_m));
-    a->Visit(MJSLAM_NVP(command_gain_v));
-    a->Visit(MJSLAM_NVP(command_gain_w));
-    a->Visit(MJSLAM_NVP(command_lag_s));
-    a->Visit(MJSLAM_NVP(command_lag_w_s));
-    a->Visit(MJSLAM_NVP(command_max_accel_mps2));
-    a->Visit(MJSLAM_NVP(command_ramp_mps2));
-    a->Visit(MJSLAM_NVP(command_ramp_radps2));
     a->Visit(MJSLAM_NVP(command_noise));
     a->Visit(MJSLAM_NVP(odometry_noise));
     a->Visit(MJSLAM_NVP(self_calibration));
     a->Visit(MJSLAM_NVP(lateral_slip_std_m_per_rad));
-    a->Visit(MJSLAM_NVP(lateral_slip_std_m_per_rad_per_mps));
-    a->Visit(MJSLAM_NVP(lateral_slip_std_m_per_radps_change));
-    a->Visit(MJSLAM_NVP(turn_centre_offset_m_per_radps));
     a->Visit(MJSLAM_NVP(lateral_skid_s));
     a->Visit(MJSLAM_NVP(jacobians));
     a->Visit(MJSLAM_NVP(initial_position_std_m));

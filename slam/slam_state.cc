@@ -68,7 +68,7 @@ Eigen::Matrix3d SlamState::MovePose(const MotionInput& input, double a_m,
                                     Eigen::Matrix<double, 3, 2>* W) {
   Eigen::Matrix3d A;
   x_.head<3>() = PredictPose(x_.head<3>(), input.increment, a_m, &A, W, input.skid_per_m_rad,
-                             input.integration, input.turn_centre);
+                             input.integration);
   if (jacobians_ == JacobianPoint::kFirstEstimates) {
     // FEJ (Huang et al. 2010): A = d pose' / d pose is the identity but for
     // the heading column, the displacement rotated by 90 deg; take the

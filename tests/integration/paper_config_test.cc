@@ -23,9 +23,6 @@ void ExpectPaperChoices(const app::RunConfig& config) {
   EXPECT_EQ(ekf.input, "command");
   EXPECT_EQ(ekf.motion_integration, "euler");
   EXPECT_EQ(ekf.lateral_slip_std_m_per_rad, 0.0);
-  EXPECT_EQ(ekf.lateral_slip_std_m_per_rad_per_mps, 0.0);
-  EXPECT_EQ(ekf.lateral_slip_std_m_per_radps_change, 0.0);
-  EXPECT_EQ(ekf.turn_centre_offset_m_per_radps, 0.0);
   EXPECT_EQ(ekf.lateral_skid_s, 0.0);
   EXPECT_TRUE(ekf.correct_corners_of_matched_lines);
   EXPECT_FALSE(ekf.corners_from_map_lines);
@@ -35,17 +32,6 @@ void ExpectPaperChoices(const app::RunConfig& config) {
   EXPECT_EQ(ekf.extra_corner_range_std_m, 0.0);
   EXPECT_EQ(ekf.extra_corner_bearing_std_rad, 0.0);
   EXPECT_EQ(ekf.command_noise.change_noise_fraction, 0.0);
-  EXPECT_EQ(ekf.command_noise.lag_noise_fraction, 0.0);
-  EXPECT_EQ(ekf.command_noise.turn_v_noise_m_per_rad, 0.0);
-  EXPECT_EQ(ekf.command_noise.speed_w_noise_rad_per_m, 0.0);
-  EXPECT_EQ(ekf.command_noise.beyond_change_noise_fraction, 0.0);
-  EXPECT_EQ(ekf.command_gain_v, 1.0);
-  EXPECT_EQ(ekf.command_gain_w, 1.0);
-  EXPECT_EQ(ekf.Following().lag_w_s, 0.0);
-  EXPECT_EQ(ekf.command_max_accel_mps2, 0.0);
-  EXPECT_EQ(ekf.command_ramp_mps2, 0.0);
-  EXPECT_EQ(ekf.command_ramp_radps2, 0.0);
-  EXPECT_EQ(ekf.command_lag_s, 0.0);
   EXPECT_EQ(ekf.jacobians, "current");
   EXPECT_EQ(ekf.max_updates, 2);
   EXPECT_EQ(ekf.selection_policy, "criterion");

@@ -63,9 +63,7 @@ TEST(EkfParamsTest, DefaultsAreValidAndBadValuesAreNamed) {
   params.new_feature_probability = 0.5;
   params.max_updates = 0;
   params.command_noise.v_noise_fraction = -1.0;
-  params.lateral_slip_std_m_per_rad_per_mps = -0.1;
-  params.lateral_slip_std_m_per_radps_change = -0.1;
-  params.turn_centre_offset_m_per_radps = std::numeric_limits<double>::infinity();
+  params.lateral_slip_std_m_per_rad = -0.1;
   const std::vector<ParamProblem> problems = params.Validate();
   std::string keys;
   for (const ParamProblem& problem : problems) keys += problem.key + " ";
@@ -75,14 +73,8 @@ TEST(EkfParamsTest, DefaultsAreValidAndBadValuesAreNamed) {
   EXPECT_NE(keys.find("new_feature_probability"), std::string::npos) << keys;
   EXPECT_NE(keys.find("max_updates"), std::string::npos) << keys;
   EXPECT_NE(keys.find("command_noise.v_noise_fraction"), std::string::npos) << keys;
-  EXPECT_NE(keys.find("lateral_slip_std_m_per_rad_per_mps"), std::string::npos) << keys;
-  EXPECT_NE(keys.find("lateral_slip_std_m_per_radps_change"), std::string::npos) << keys;
-  EXPECT_NE(keys.find("turn_centre_offset_m_per_radps"), std::string::npos) << keys;
+  EXPECT_NE(keys.find("lateral_slip_std_m_per_rad"), std::string::npos) << keys;
   EXPECT_THROW(params.ValidateOrThrow(), ParamError);
-  // The offset is signed: a negative value is valid.
-  EkfParams left;
-  left.turn_centre_offset_m_per_radps = -1e-4;
-  EXPECT_TRUE(left.Validate().empty());
 }
 
 TEST(EkfParamsTest, MotionIntegrationAndSelectionPolicyAreNamedChoices) {
