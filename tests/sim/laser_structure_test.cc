@@ -112,7 +112,7 @@ TEST(LaserStructureTest, NoiseSigmaGrowsWithRangeAsConfigured) {
     const double mean = sum / n;
     const double sigma = std::sqrt(sum_sq / n - mean * mean);
     const double expected = 0.005 + 0.002 * range;
-    std::cout << "range " << range << " m: mean " << mean << ", sigma " << sigma
+    std::cout << "seed 7, range " << range << " m: mean " << mean << ", sigma " << sigma
               << " (configured " << expected << ")\n";
     EXPECT_NEAR(mean, 0.003, 4.0 * expected / std::sqrt(n)) << range;
     EXPECT_NEAR(sigma, expected, 4.0 * expected / std::sqrt(2.0 * n)) << range;
@@ -156,7 +156,7 @@ TEST(LaserStructureTest, GrazingDropoutsFollowTheConfiguredCurve) {
     const double p = 0.8 * std::clamp((theta - 60.0) / 30.0, 0.0, 1.0);
     EXPECT_NEAR(noise.GrazingDropoutProbability(DegToRad(theta)), p, 1e-12);
     const double rate = static_cast<double>(dropped[k]) / trials[k];
-    std::cout << "incidence " << theta << " deg: dropout rate " << rate << " (configured " << p
+    std::cout << "seed 11, incidence " << theta << " deg: dropout rate " << rate << " (configured " << p
               << ", " << trials[k] << " trials)\n";
     if (p == 0.0) {
       EXPECT_EQ(dropped[k], 0) << theta;
@@ -211,7 +211,7 @@ TEST(LaserStructureTest, MixedPixelsOnlyAtDiscontinuitiesAndBetweenTheRanges) {
     }
   }
   const double rate = static_cast<double>(mixed) / edge_beams;
-  std::cout << "mixed pixels: " << mixed << " of " << edge_beams << " edge beams (" << rate
+  std::cout << "seed 5, mixed pixels: " << mixed << " of " << edge_beams << " edge beams (" << rate
             << ", configured 0.4)\n";
   EXPECT_NEAR(rate, 0.4, 4.0 * std::sqrt(0.4 * 0.6 / edge_beams));
 }
