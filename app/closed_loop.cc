@@ -147,7 +147,13 @@ void ClosedLoop::SenseWorld() {
   out_.X_WS_true = w.simulator.X_WS();
   if (record.has_scan) {
     const std::vector<double> jitter = w.laser_noise.DrawAngleOffsets();
-    record.scan = w.laser_noise.Apply(w.simulator.CastLaser(config_.laser, jitter));
+    if (config_.laser.HasMixedPixels() || config_.laser.HasGrazingDropouts()) {
+      sim::LaserFootprint footprint;
+      const LaserScan exact = w.simulator.CastLaser(config_.laser, jitter, &footprint);
+      record.scan = w.laser_noise.Apply(exact, &footprint);
+    } else {
+      record.scan = w.laser_noise.Apply(w.simulator.CastLaser(config_.laser, jitter));
+    }
     record.scan.t_s = t;
     laps_.Charge(&cpu_.laser_s);
   }

@@ -53,6 +53,15 @@ std::vector<ParamProblem> LaserParams::Validate() const {
   check.InRange("range_scale_std_fraction", range_scale_std_fraction, 0.0, 0.2);
   check.NonNegative("angle_jitter_std_deg", angle_jitter_std_deg);
   check.InRange("dropout_probability", dropout_probability, 0.0, 1.0);
+  check.InRange("range_noise_std_per_m", range_noise_std_per_m, 0.0, 0.1);
+  check.InRange("range_resolution_m", range_resolution_m, 0.0, 1.0);
+  check.InRange("mixed_pixel_probability", mixed_pixel_probability, 0.0, 1.0);
+  check.Positive("mixed_pixel_min_step_m", mixed_pixel_min_step_m);
+  check.InRange("beam_divergence_deg", beam_divergence_deg, 0.0, 10.0);
+  check.InRange("footprint_rays", footprint_rays, 2, 64);
+  check.InRange("grazing_dropout_probability", grazing_dropout_probability, 0.0, 1.0);
+  check.Require(grazing_dropout_start_deg >= 0.0 && grazing_dropout_start_deg < 90.0,
+                "grazing_dropout_start_deg", grazing_dropout_start_deg, "a value in [0, 90)");
   return check.problems();
 }
 

@@ -135,8 +135,52 @@ struct LaserParams {
   /// Standard deviation of the per-beam angular jitter, degrees: the beam is
   /// cast at its nominal angle plus this error, but reported at the nominal one.
   double angle_jitter_std_deg = 0.0;
-  /// Probability that a beam loses its echo (reported as no-return at max range).
+  /// Probability that a beam loses its echo (reported as no-return at max
+  /// range): the random maximum-range readings of the beam model (Thrun et
+  /// al., Sec. 6.3, p_max), whatever the surface.
   double dropout_probability = 0.0;
+
+  // The SICK's error structure (docs/method.md, "The SICK's error
+  // structure"; sim/laser_noise.h). Every key off by default: with all of
+  // them off the scans are bit for bit those without them.
+
+  /// Range-dependent noise: the Gaussian noise's standard deviation grows to
+  /// range_noise_std_m + range_noise_std_per_m * range (metres per metre of
+  /// range); the extra part is drawn from stream "laser.range_growth".
+  double range_noise_std_per_m = 0.0;
+  /// The sensor's range resolution, metres: every echo is reported rounded
+  /// to a multiple of it (the LMS200: 0.01 in its cm mode, 0.001 in mm
+  /// mode). 0: not rounded.
+  double range_resolution_m = 0.0;
+  /// Mixed pixels: a beam whose footprint straddles a depth discontinuity
+  /// (a sub-ray reads more than mixed_pixel_min_step_m from where the line
+  /// through its two neighbours' hits crosses it; on a flat surface, however
+  /// grazing, they line up) returns, with this probability (stream
+  /// "laser.mixed_pixel"), the mean
+  /// of its sub-rays' ranges instead of its centre ray's: a range between
+  /// the two surfaces, weighted by how much of the footprint each covers.
+  double mixed_pixel_probability = 0.0;
+  /// Smallest departure of a sub-ray's range from its neighbours' line that
+  /// counts as a depth discontinuity, metres.
+  double mixed_pixel_min_step_m = 0.1;
+  /// Full angle of the beam's footprint, degrees (its divergence): the
+  /// sub-rays of the mixed-pixel model spread over it.
+  double beam_divergence_deg = 0.25;
+  /// Sub-rays cast across each beam's footprint (only with mixed pixels on).
+  int footprint_rays = 5;
+  /// Dropouts at grazing incidence: a beam whose angle of incidence theta
+  /// (between the beam and the surface's normal) exceeds
+  /// grazing_dropout_start_deg loses its echo with probability
+  /// grazing_dropout_probability * (theta - start) / (90 deg - start),
+  /// rising linearly to grazing_dropout_probability at 90 degrees (stream
+  /// "laser.grazing").
+  double grazing_dropout_probability = 0.0;
+  double grazing_dropout_start_deg = 70.0;
+
+  /// Whether any key of the error structure above is on (then
+  /// Simulator::CastLaser casts what sim/laser_footprint.h describes).
+  bool HasMixedPixels() const { return mixed_pixel_probability > 0.0; }
+  bool HasGrazingDropouts() const { return grazing_dropout_probability > 0.0; }
 
   /// Bearing of beam 0 in S, radians.
   double AngleMinRad() const;
@@ -156,6 +200,14 @@ struct LaserParams {
     a->Visit(MJSLAM_NVP(range_scale_std_fraction));
     a->Visit(MJSLAM_NVP(angle_jitter_std_deg));
     a->Visit(MJSLAM_NVP(dropout_probability));
+    a->Visit(MJSLAM_NVP(range_noise_std_per_m));
+    a->Visit(MJSLAM_NVP(range_resolution_m));
+    a->Visit(MJSLAM_NVP(mixed_pixel_probability));
+    a->Visit(MJSLAM_NVP(mixed_pixel_min_step_m));
+    a->Visit(MJSLAM_NVP(beam_divergence_deg));
+    a->Visit(MJSLAM_NVP(footprint_rays));
+    a->Visit(MJSLAM_NVP(grazing_dropout_probability));
+    a->Visit(MJSLAM_NVP(grazing_dropout_start_deg));
   }
   std::vector<ParamProblem> Validate() const;
   void ValidateOrThrow() const { ThrowIfProblems(Validate()); }

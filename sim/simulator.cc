@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <sstream>
 #include <utility>
 
@@ -434,7 +435,8 @@ std::array<double, 2> Simulator::WheelVelocities() const {
 }
 
 LaserScan Simulator::CastLaser(const LaserParams& laser,
-                               const std::vector<double>& beam_angle_offsets_rad) const {
+                               const std::vector<double>& beam_angle_offsets_rad,
+                               LaserFootprint* footprint) const {
   laser.ValidateOrThrow();
   if (!beam_angle_offsets_rad.empty() &&
       static_cast<int>(beam_angle_offsets_rad.size()) != laser.num_beams) {
@@ -465,6 +467,26 @@ LaserScan Simulator::CastLaser(const LaserParams& laser,
   const double* offsets = beam_angle_offsets_rad.empty() ? nullptr : beam_angle_offsets_rad.data();
   double* ranges = scan.ranges_m.data();
   auto* has_return = scan.has_return.data();
+  // The range of one ray at world bearing `bearing_W`; max_range_m for no echo.
+  auto cast = [&](double bearing_W) {
+    const mjtNum direction[3] = {std::cos(bearing_W), std::sin(bearing_W), 0.0};
+    int geom = -1;
+    const mjtNum distance =
+        local != nullptr ? local->CastRay(*m, *d, origin, direction, laser.max_range_m)
+                         : mj_ray(m, d, origin, direction, geom_groups, 1, -1, &geom);
+    return distance >= 0.0 && distance < laser.max_range_m ? static_cast<double>(distance)
+                                                           : laser.max_range_m;
+  };
+  const int rays = footprint != nullptr && laser.HasMixedPixels() ? laser.footprint_rays : 0;
+  const bool incidence = footprint != nullptr && laser.HasGrazingDropouts();
+  if (footprint != nullptr) {
+    footprint->rays_per_beam = rays;
+    footprint->sub_ranges_m.assign(static_cast<std::size_t>(laser.num_beams) * rays,
+                                   laser.max_range_m);
+    footprint->incidence_rad.assign(incidence ? laser.num_beams : 0,
+                                    std::numeric_limits<double>::quiet_NaN());
+  }
+  const double divergence = DegToRad(laser.beam_divergence_deg);
   // One trapped call for the sweep; its body touches plain data only.
   CallMujoco("casting the laser", [&] {
     for (int i = 0; i < laser.num_beams; ++i) {
@@ -478,6 +500,31 @@ LaserScan Simulator::CastLaser(const LaserParams& laser,
       if (distance >= 0.0 && distance < laser.max_range_m) {
         ranges[i] = distance;
         has_return[i] = 1;
+      }
+      // The footprint's sub-rays, evenly from -divergence/2 to +divergence/2.
+      for (int j = 0; j < rays; ++j) {
+        const double sub = divergence * (static_cast<double>(j) / (rays - 1) - 0.5);
+        footprint->sub_ranges_m[static_cast<std::size_t>(i) * rays + j] = cast(bearing_W + sub);
+      }
+      // The incidence: the beam against the normal of the chord through the
+      // hits of two probes either side of it.
+      if (incidence && has_return[i]) {
+        const double probe = LaserFootprint::kProbeRad;
+        const double r_minus = cast(bearing_W - probe);
+        const double r_plus = cast(bearing_W + probe);
+        if (r_minus < laser.max_range_m && r_plus < laser.max_range_m) {
+          const double tx = r_plus * std::cos(bearing_W + probe) -
+                            r_minus * std::cos(bearing_W - probe);
+          const double ty = r_plus * std::sin(bearing_W + probe) -
+                            r_minus * std::sin(bearing_W - probe);
+          const double length = std::hypot(tx, ty);
+          if (length > 0.0) {
+            // |u x t| / |t| is the cosine of the angle between u and the normal.
+            const double cos_incidence =
+                std::min(std::abs(direction[0] * ty - direction[1] * tx) / length, 1.0);
+            footprint->incidence_rad[i] = std::acos(cos_incidence);
+          }
+        }
       }
     }
   });

@@ -9,6 +9,7 @@
 #include "common/laser_scan.h"
 #include "common/pose2.h"
 #include "common/records.h"
+#include "sim/laser_footprint.h"
 #include "sim/mujoco_errors.h"
 #include "sim/scene.h"
 #include "sim/sim_params.h"
@@ -113,8 +114,13 @@ class Simulator {
   /// scan reports the nominal bearings. Throws ParamError for invalid
   /// `laser`, SimError for a wrong number of offsets or a MuJoCo error. Cast
   /// only at the scan rate: it costs num_beams ray casts.
+  /// `footprint` (optional): filled with what the laser's error structure
+  /// needs (sim/laser_footprint.h): footprint_rays more casts per beam with
+  /// mixed pixels on, two more with grazing dropouts on; the scan itself is
+  /// the same with or without it.
   LaserScan CastLaser(const LaserParams& laser,
-                      const std::vector<double>& beam_angle_offsets_rad = {}) const;
+                      const std::vector<double>& beam_angle_offsets_rad = {},
+                      LaserFootprint* footprint = nullptr) const;
 
   /// Whether contacts and laser beams consider only the world geoms that
   /// matter (true, the default) or every geom (false: MuJoCo's all-pairs

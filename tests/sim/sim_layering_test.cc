@@ -23,7 +23,7 @@ std::string ReadSource(const std::string& relative_path) {
 TEST(SimLayeringTest, OnlyTheMujocoAdapterIncludesMujoco) {
   for (const char* file :
        {"sim/sim_params.h", "sim/sim_params.cc", "sim/diff_drive.h", "sim/diff_drive.cc",
-        "sim/laser_noise.h", "sim/laser_noise.cc", "sim/wheel_odometry.h",
+        "sim/laser_noise.h", "sim/laser_noise.cc", "sim/laser_footprint.h", "sim/wheel_odometry.h",
         "sim/wheel_odometry.cc", "sim/obstacles.h", "sim/obstacles.cc", "sim/simulator.h",
         "sim/scene.h", "sim/mujoco_errors.h", "sim/box_grid.h", "sim/box_grid.cc"}) {
     const std::string text = ReadSource(file);

@@ -72,7 +72,12 @@ TEST(SimParamsTest, SerializeVisitsEveryFieldUnderItsKey) {
             (std::vector<std::string>{"num_beams", "fov_deg", "max_range_m", "rate_hz",
                                       "range_noise_std_m", "range_bias_m", "range_bias_std_m",
                                       "range_scale_fraction", "range_scale_std_fraction",
-                                      "angle_jitter_std_deg", "dropout_probability"}));
+                                      "angle_jitter_std_deg", "dropout_probability",
+                                      "range_noise_std_per_m", "range_resolution_m",
+                                      "mixed_pixel_probability", "mixed_pixel_min_step_m",
+                                      "beam_divergence_deg", "footprint_rays",
+                                      "grazing_dropout_probability",
+                                      "grazing_dropout_start_deg"}));
   EXPECT_EQ(Keys<OdometryParams>(),
             (std::vector<std::string>{"ticks_per_wheel_revolution", "slip_std_fraction",
                                       "wheel_radius_error_std_fraction",
@@ -104,9 +109,13 @@ TEST(SimParamsTest, BadValuesAreReportedUnderTheirKeys) {
   laser.fov_deg = 400.0;
   laser.range_noise_std_m = -0.001;
   laser.dropout_probability = 1.1;
+  laser.mixed_pixel_probability = -0.1;
+  laser.footprint_rays = 1;
+  laser.grazing_dropout_start_deg = 90.0;
   EXPECT_EQ(ProblemKeys(laser.Validate()),
             (std::vector<std::string>{"num_beams", "fov_deg", "range_noise_std_m",
-                                      "dropout_probability"}));
+                                      "dropout_probability", "mixed_pixel_probability",
+                                      "footprint_rays", "grazing_dropout_start_deg"}));
   EXPECT_THROW(laser.ValidateOrThrow(), ParamError);
 
   OdometryParams odometry;
