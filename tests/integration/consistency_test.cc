@@ -112,10 +112,10 @@ TEST(ConsistencyCheckTest, DetectsMeasurementNoiseUnderstatedTenTimes) {
 // - the turns: neither filter's average NEES may go above its upper bound
 //   (for the runs still going at that step) for more than 5 % of the steps.
 // - the innovations: the mean over the runs of each run's mean NIS of the
-//   matched observations must lie in [1.0, 2.2] (the gate-truncated 2-dof
-//   chi-square mean is 1.907; the default's noise covers the envelope, so
-//   below it is allowed).
-// Measured: MEASURED_CLOSED_LOOP.
+//   matched observations must lie in [1.6, 2.2] around the gate-truncated
+//   2-dof chi-square mean 1.907.
+// Measured (1390 steps): above 0.000 / 0.001 (classical / selective), mean
+// ANEES 2.10 / 1.76; mean NIS 1.81 / 1.80.
 TEST(ClosedLoopConsistencyTest, TurnsAndInnovationsOfTheDefault) {
   const std::string dir = FreshDir("closed_loop");
   const nlohmann::json summary =
@@ -134,7 +134,7 @@ TEST(ClosedLoopConsistencyTest, TurnsAndInnovationsOfTheDefault) {
     ASSERT_EQ(runs, 10) << f;
     const double mean_nis = sum / runs;
     std::printf("closed_loop: %s: mean NIS over %d runs %.3f\n", f.c_str(), runs, mean_nis);
-    EXPECT_GE(mean_nis, 1.0) << f;
+    EXPECT_GE(mean_nis, 1.6) << f;
     EXPECT_LE(mean_nis, 2.2) << f;
   }
 }
@@ -148,7 +148,8 @@ TEST(ClosedLoopConsistencyTest, TurnsAndInnovationsOfTheDefault) {
 // band for >= 91 % of the steps. Measured (docs/results.md, "The envelope"):
 // above 0.001 / 0.010, 2-sigma 0.965-0.987.
 // The same filters without self-calibration fail it on the same runs
-// (measured: MEASURED_NO_SELF_CALIBRATION): the second test.
+// (measured: above 0.987 / 0.987, mean ANEES 364 / 199, x inside 2 sigma
+// 0.20 / 0.46): the second test.
 const std::vector<std::string> kRangeBias15mm = {"run.seed=700", "render.enabled=false",
                                                  "laser.range_bias_m=0.015",
                                                  "laser.range_bias_std_m=0"};
