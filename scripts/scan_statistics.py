@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Statistics of laser scans, simulated or real, side by side (docs/results/laser_structure.md).
+"""Statistics of laser scans, simulated or real, side by side (docs/results.md, "The SICK's error structure").
 
 For each run directory (a simulated run of `mjslam run`, or a real log turned into
 one by `mjslam import LOG --out DIR`) it reads `scans.csv` (ranges r0..r<n-1>,
