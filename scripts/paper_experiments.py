@@ -508,6 +508,9 @@ def main():
     parser.add_argument("--scale-duration", type=float, default=3000.0,
                         help="time limit of a scale run without its own, s [3000]")
     parser.add_argument("--mjslam", default="build/mjslam", help="the program [build/mjslam]")
+    parser.add_argument("--readme", default=None,
+                        help="also write the short verdict table into this file (README.md) "
+                        "between its claims markers")
     args = parser.parse_args()
 
     mjslam = args.mjslam if os.path.isabs(args.mjslam) else os.path.join(ROOT, args.mjslam)
@@ -549,6 +552,45 @@ def main():
         json.dump({"claims": claims_json,
                    "studies": {m: results[m]["studies"] for m in args.models}}, f, indent=1)
     print(text)
+    if args.readme:
+        write_readme_table(args.readme, results, args.models, command.strip())
+
+
+README_BEGIN = "<!-- claims table: made by scripts/paper_experiments.py --readme; do not edit -->\n"
+README_END = "<!-- end of claims table -->\n"
+
+
+def short(text):
+    """The first part of a claim's figures (up to its first ';'), for the README."""
+    first = text.split("; ")[0]
+    return first if len(first) <= 200 else first[:197] + "..."
+
+
+def write_readme_table(path, results, models, command):
+    """Replaces the table between the README's claims markers with verdicts and
+    their first figures, dated and with the commit of the program."""
+    with open(path) as f:
+        readme = f.read()
+    if README_BEGIN not in readme or README_END not in readme:
+        raise SystemExit("%s: no claims markers ('%s' ... '%s')" % (
+            path, README_BEGIN.strip(), README_END.strip()))
+    commit = subprocess.run(["git", "-C", ROOT, "rev-parse", "--short", "HEAD"],
+                            capture_output=True, text=True).stdout.strip() or "unknown"
+    lines = ["Made on %s at commit %s by `%s --readme README.md`." % (
+        time.strftime("%Y-%m-%d", time.gmtime()), commit, command.split(" --readme")[0]), "",
+             "| Claim of the paper | " + " | ".join("%s model" % m for m in models) + " |",
+             "|---|" + "---|" * len(models)]
+    for name, _, judge in CLAIMS:
+        cells = []
+        for m in models:
+            text, verdict = judge(results[m])
+            cells.append("**%s**: %s" % (verdict, short(text)))
+        lines.append("| %s | %s |" % (name, " | ".join(cells)))
+    begin = readme.index(README_BEGIN) + len(README_BEGIN)
+    end = readme.index(README_END)
+    with open(path + ".tmp", "w") as f:
+        f.write(readme[:begin] + "\n".join(lines) + "\n" + readme[end:])
+    os.replace(path + ".tmp", path)
 
 
 if __name__ == "__main__":

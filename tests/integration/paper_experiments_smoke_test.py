@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """Smoke test of scripts/paper_experiments.py: tiny settings, then checks that the claims table
-has every claim with a verdict under both models, that every figure is a PNG, and that the
-study with the paper's Gaussians drew its own number of realisations.
+has every claim with a verdict under both models, that every figure is a PNG, that the
+study with the paper's Gaussians drew its own number of realisations, and that --readme
+replaces the table between a README's markers and nothing else.
 
     /usr/bin/python3 tests/integration/paper_experiments_smoke_test.py SOURCE_DIR MJSLAM
 
@@ -20,12 +21,17 @@ VERDICTS = ("**yes**", "**partly**", "**no**")
 
 def main(source_dir, mjslam):
     out = tempfile.mkdtemp(prefix="paper_smoke_")
+    readme = os.path.join(out, "README.md")
+    with open(readme, "w") as f:
+        f.write("before\n<!-- claims table: made by scripts/paper_experiments.py --readme; "
+                "do not edit -->\nold table\n<!-- end of claims table -->\nafter\n")
     try:
         command = ["/usr/bin/python3", os.path.join(source_dir, "scripts", "paper_experiments.py"),
                    "--out", out, "--mjslam", mjslam, "--runs", "2", "--jobs", "2",
                    "--duration", "8", "--office-runs", "1", "--office-duration", "8",
                    "--points", "100", "20000", "25000", "--realisations", "2",
-                   "--paper-study-realisations", "1", "--scale-duration", "8"]
+                   "--paper-study-realisations", "1", "--scale-duration", "8",
+                   "--readme", readme]
         result = subprocess.run(command, cwd=source_dir, capture_output=True, text=True)
         problems = []
         if result.returncode != 0:
@@ -38,6 +44,12 @@ def main(source_dir, mjslam):
         for row in rows:
             if sum(row.count(v) for v in VERDICTS) != 2:
                 problems.append("claims.md: not one verdict per model in: %s" % row[:80])
+        lines = open(readme).read().splitlines()
+        table = [line for line in lines if line.startswith("| (")]
+        if (lines[0] != "before" or lines[-1] != "after" or "old table" in lines
+                or len(table) != 5 or any(sum(r.count(v) for v in VERDICTS) != 2 for r in table)):
+            problems.append("--readme: the README is not the table between its markers:\n%s"
+                            % "\n".join(lines[:12]))
         names = ["%s_%s.png" % (f, m) for f in FIGURES for m in ("default", "paper")]
         for name in names + ["fig4cd_scale.png"]:
             path = os.path.join(out, "figures", name)
