@@ -9,6 +9,8 @@
 #include <stdexcept>
 
 #include "common/angles.h"
+#include "common/interrupt.h"
+#include "realdata/carmen_log.h"
 
 namespace mjslam::realdata {
 namespace {
@@ -30,6 +32,7 @@ std::pair<double, double> MeanStd(const std::vector<double>& values) {
 }  // namespace
 
 std::vector<Relation> ReadRelations(const std::string& path) {
+  RequireRegularFile(path);
   std::ifstream in(path);
   if (!in) throw std::runtime_error(path + ": cannot open");
   std::vector<Relation> relations;
@@ -37,6 +40,11 @@ std::vector<Relation> ReadRelations(const std::string& path) {
   int line_number = 0;
   while (std::getline(in, line)) {
     ++line_number;
+    if (line_number % 1024 == 0) ThrowIfInterrupted("reading the relations");
+    if (line.size() > kMaxLogLineBytes) {
+      throw std::runtime_error(path + ":" + std::to_string(line_number) + ": line longer than " +
+                               std::to_string(kMaxLogLineBytes) + " bytes (not a relations file?)");
+    }
     std::istringstream fields(line);
     std::vector<double> values;
     std::string token;
@@ -45,7 +53,7 @@ std::vector<Relation> ReadRelations(const std::string& path) {
       const double value = std::strtod(token.c_str(), &end);
       if (end == token.c_str() || *end != '\0' || !std::isfinite(value)) {
         throw std::runtime_error(path + ":" + std::to_string(line_number) +
-                                 ": expected a number (got '" + token + "')");
+                                 ": expected a number (got '" + Shown(token) + "')");
       }
       values.push_back(value);
     }
@@ -112,20 +120,33 @@ RelationErrors ScoreRelations(const std::vector<Relation>& relations,
 
 double BestTimeOffset(const std::vector<Relation>& relations,
                       const std::vector<TimedPose>& trajectory, double tolerance_s,
-                      int* num_matched_times) {
+                      int* num_matched_times, std::size_t max_candidates) {
+  if (!(tolerance_s > 0.0) || !std::isfinite(tolerance_s)) {
+    throw std::invalid_argument("relation time offset search: the tolerance must be a finite "
+                                "number of seconds > 0 (got " + std::to_string(tolerance_s) + ")");
+  }
   std::set<double> times;
   for (const Relation& relation : relations) {
     times.insert(relation.t1_s);
     times.insert(relation.t2_s);
+  }
+  // The search holds every candidate at once: refuse before allocating.
+  if (!trajectory.empty() && times.size() > max_candidates / trajectory.size()) {
+    throw std::length_error(
+        "relation time offset search: " + std::to_string(times.size()) + " relation times x " +
+        std::to_string(trajectory.size()) + " poses are more than " +
+        std::to_string(max_candidates) + " candidate offsets");
   }
   // Every relation time minus every pose time, sorted: the densest window
   // of width 2 tolerance_s is the offset most times agree on.
   std::vector<double> differences;
   differences.reserve(times.size() * trajectory.size());
   for (double t : times) {
+    ThrowIfInterrupted("relation time offset search");
     for (const TimedPose& pose : trajectory) differences.push_back(t - pose.t_s);
   }
   std::sort(differences.begin(), differences.end());
+  ThrowIfInterrupted("relation time offset search");
   std::size_t best_first = 0, best_count = 0, first = 0;
   for (std::size_t last = 0; last < differences.size(); ++last) {
     while (differences[last] - differences[first] > 2.0 * tolerance_s) ++first;
