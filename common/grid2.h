@@ -9,6 +9,7 @@
 #include <Eigen/Core>
 
 #include "common/check.h"
+#include "common/interrupt.h"
 
 namespace mjslam {
 
@@ -118,7 +119,9 @@ enum class Connectivity {
 /// `reached` and `passable(ix, iy)`, and marks it. Cells already marked in
 /// `reached` on entry are walls too, so successive fills into one `reached`
 /// grid find disjoint regions. Returns the linear indices of the cells
-/// reached by this fill, in the order of the breadth-first visit.
+/// reached by this fill, in the order of the breadth-first visit. Throws
+/// Interrupted (common/interrupt.h) on a stop request (checked every 2^16
+/// cells, a few milliseconds).
 template <typename Passable>
 std::vector<int> FloodFill(const Eigen::Vector2i& start, Connectivity connectivity,
                            const Passable& passable, Grid2<std::uint8_t>* reached) {
@@ -140,6 +143,7 @@ std::vector<int> FloodFill(const Eigen::Vector2i& start, Connectivity connectivi
     const int c = queue.front();
     queue.pop_front();
     visited.push_back(c);
+    if ((visited.size() & 0xFFFF) == 0) ThrowIfInterrupted("flood fill");
     const Eigen::Vector2i cell = limits.CellOfIndex(c);
     for (int k = 0; k < num_neighbours; ++k) {
       const int nx = cell.x() + dx[k];

@@ -76,4 +76,11 @@ class Scene {
   std::shared_ptr<const Impl> impl_;
 };
 
+/// Throws SimError naming the world file, the geom that lies farthest out
+/// and the key, when the footprints of the world's obstacles (by their
+/// bounding discs) and its start do not fit in an axis-aligned square of
+/// side `max_extent_m` (SimParams::max_world_extent_m), or one is not
+/// finite. Called before any grid over the world is allocated.
+void CheckWorldExtent(const Scene& scene, double max_extent_m);
+
 }  // namespace mjslam::sim
