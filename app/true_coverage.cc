@@ -39,7 +39,7 @@ Grid2<double> ClearanceGrid(const std::vector<sim::ObstacleFootprint>& obstacles
     const Eigen::Vector2i lo = limits.CellOf(box_lo - Eigen::Vector2d::Constant(cutoff_m));
     const Eigen::Vector2i hi = limits.CellOf(box_hi + Eigen::Vector2d::Constant(cutoff_m));
     for (int j = std::max(0, lo.y()); j <= std::min(limits.height() - 1, hi.y()); ++j) {
-      if (j % 64 == 0) ThrowIfInterrupted("world setup (coverage grid)");
+      ThrowIfInterrupted("world setup (coverage grid)");
       for (int i = std::max(0, lo.x()); i <= std::min(limits.width() - 1, hi.x()); ++i) {
         clearance(i, j) =
             std::min(clearance(i, j), sim::DistanceToFootprint(limits.CellCenter(i, j), o));

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <deque>
@@ -82,8 +83,18 @@ class Grid2 {
   /// An empty grid.
   Grid2() = default;
   /// Every cell of `limits` set to `value`.
-  explicit Grid2(const GridLimits& limits, const T& value = T())
-      : limits_(limits), cells_(static_cast<std::size_t>(limits.num_cells()), value) {}
+  /// Filled in blocks of 2^20 cells, each after a look at the stop request
+  /// (a large grid's first touch of its memory takes seconds): throws
+  /// Interrupted (common/interrupt.h).
+  explicit Grid2(const GridLimits& limits, const T& value = T()) : limits_(limits) {
+    const std::size_t n = static_cast<std::size_t>(limits.num_cells());
+    cells_.reserve(n);
+    constexpr std::size_t kBlock = std::size_t{1} << 20;
+    for (std::size_t done = 0; done < n; done += kBlock) {
+      ThrowIfInterrupted("grid allocation");
+      cells_.insert(cells_.end(), std::min(kBlock, n - done), value);
+    }
+  }
 
   /// The grid's limits.
   const GridLimits& limits() const { return limits_; }
