@@ -397,6 +397,7 @@ ImportReport ImportLog(RunConfig config, const ImportOptions& options) {
   }
   // Every value checked before anything is written.
   const std::vector<RecordedRow> rows = RecordedRows(s, log.path);
+  if (options.check_only) return report;
 
   const std::string& dir = options.out_dir;
   const rundir::RunDirectoryLock lock(dir);

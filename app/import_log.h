@@ -47,6 +47,9 @@ struct ImportOptions {
   /// The most candidate offsets (relation times x scans) the search may
   /// hold, 8 bytes each (realdata::BestTimeOffset).
   std::size_t max_offset_candidates = realdata::kMaxOffsetCandidates;
+  /// Read and check everything (the log, the relations, the offset search,
+  /// every value written), then return without writing (the fuzz target).
+  bool check_only = false;
 };
 
 /// What an import read and wrote, for the command's report.

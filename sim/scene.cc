@@ -378,13 +378,18 @@ std::string Scene::Description() const {
 }
 
 void CheckWorldExtent(const Scene& scene, double max_extent_m) {
-  const Eigen::Vector2d start = scene.StartPose().translation();
+  CheckWorldExtent(scene.world_path(), scene.StartPose().translation(), scene.Obstacles(),
+                   max_extent_m);
+}
+
+void CheckWorldExtent(const std::string& world_path, const Eigen::Vector2d& start,
+                      const std::vector<ObstacleFootprint>& obstacles, double max_extent_m) {
   Eigen::Vector2d lo = start, hi = start;
   // The obstacle that reaches farthest from the start along an axis, for the
   // message.
   const ObstacleFootprint* farthest = nullptr;
   double farthest_m = 0.0;
-  for (const ObstacleFootprint& o : scene.Obstacles()) {
+  for (const ObstacleFootprint& o : obstacles) {
     // The footprint's axis-aligned bounds: a rectangle's corners, a disc's box.
     Eigen::Vector2d o_lo = o.X_WO.translation(), o_hi = o_lo;
     if (o.shape == ObstacleFootprint::Shape::kRectangle) {
@@ -409,7 +414,7 @@ void CheckWorldExtent(const Scene& scene, double max_extent_m) {
   const double extent = (hi - lo).maxCoeff();
   if (std::isfinite(farthest_m) && extent <= max_extent_m) return;
   std::ostringstream message;
-  message << "world '" << scene.world_path() << "' spans " << extent
+  message << "world '" << world_path << "' spans " << extent
           << " m, more than sim.max_world_extent_m = " << max_extent_m << " m";
   if (farthest != nullptr) {
     message << " (geom " << (farthest->name.empty() ? "without a name" : "'" + farthest->name + "'")

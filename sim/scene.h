@@ -83,4 +83,9 @@ class Scene {
 /// finite. Called before any grid over the world is allocated.
 void CheckWorldExtent(const Scene& scene, double max_extent_m);
 
+/// The same check of `obstacles` and `p_W_start` of the world at
+/// `world_path` (for messages).
+void CheckWorldExtent(const std::string& world_path, const Eigen::Vector2d& p_W_start,
+                      const std::vector<ObstacleFootprint>& obstacles, double max_extent_m);
+
 }  // namespace mjslam::sim
