@@ -16,6 +16,8 @@ namespace mjslam::realdata {
 namespace {
 
 constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
+// The largest relation time, seconds (UNIX time in the year 2286).
+constexpr double kMaxRelationTimeS = 1e10;
 
 // Mean and standard deviation (n - 1) of `values`; 0 for the std below 2.
 std::pair<double, double> MeanStd(const std::vector<double>& values) {
@@ -62,6 +64,16 @@ std::vector<Relation> ReadRelations(const std::string& path) {
       throw std::runtime_error(path + ":" + std::to_string(line_number) +
                                ": expected 8 numbers (t1 t2 dx dy dz droll dpitch dyaw), got " +
                                std::to_string(values.size()));
+    }
+    // Times as the logs' (UNIX time at most), poses within the run
+    // directory's limits: sums and means of them stay finite.
+    const bool times_ok = std::abs(values[0]) <= kMaxRelationTimeS && std::abs(values[1]) <= kMaxRelationTimeS;
+    bool deltas_ok = true;
+    for (std::size_t i = 2; i < 8; ++i) deltas_ok = deltas_ok && std::abs(values[i]) <= 1e6;
+    if (!times_ok || !deltas_ok) {
+      throw std::runtime_error(path + ":" + std::to_string(line_number) +
+                               ": expected times within +-1e10 s and offsets within +-1e6 (got '" +
+                               Shown(line) + "')");
     }
     Relation relation;
     relation.t1_s = values[0];

@@ -115,6 +115,9 @@ TEST(RelationsTest, BestTimeOffsetRefusesABadToleranceAndTooManyCandidates) {
         << tolerance;
   }
   EXPECT_THROW(BestTimeOffset(relations, scans, 0.006, nullptr, 199), std::length_error);
+  // Times of 1e308 made the offset infinite (found by the fuzz target import).
+  EXPECT_THROW(ReadRelations(WriteFile("huge.relations", "1e308 1.5e308 0 0 0 0 0 0\n")),
+               std::runtime_error);
   EXPECT_NO_THROW(BestTimeOffset(relations, scans, 0.006, nullptr, 200));
 }
 
