@@ -3,7 +3,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
+#include <map>
 #include <set>
 #include <stdexcept>
 
@@ -24,6 +26,8 @@ std::string FolderSafe(const std::string& text) {
                     c == '.' || c == '_' || c == '-' || c == '=' || c == '+';
     if (!ok) c = '_';
   }
+  // No ".", ".." or hidden folder: a name of dots would be the folder above.
+  if (!safe.empty() && safe[0] == '.') safe[0] = '_';
   return safe;
 }
 
@@ -109,7 +113,35 @@ CampaignParams CampaignFromOptions(const std::vector<std::string>& worlds,
   return campaign;
 }
 
+std::size_t CampaignCellCount(const CampaignParams& campaign, std::size_t limit) {
+  std::size_t count = std::max<std::size_t>(campaign.worlds.size(), 1);
+  for (const CampaignAxis& axis : campaign.axes) {
+    if (count > limit) break;
+    count *= axis.values.size();  // at most limit x 2^32: no overflow in 64 bits
+  }
+  return std::min(count, limit + 1);
+}
+
+void CheckDistinctValues(const CampaignParams& campaign) {
+  for (const CampaignAxis& axis : campaign.axes) {
+    // A value's meaning: the number it spells, or its text.
+    std::map<std::string, std::string> seen;
+    for (const std::string& value : axis.values) {
+      char* end = nullptr;
+      const double number = std::strtod(value.c_str(), &end);
+      const bool numeric = end != value.c_str() && *end == '\0';
+      const std::string meaning = numeric ? "number " + ValueText(number) : "text " + value;
+      const auto [it, fresh] = seen.emplace(meaning, value);
+      if (!fresh) {
+        throw std::runtime_error("campaign axis " + axis.key + ": the values '" + it->second +
+                                 "' and '" + value + "' are the same value (two identical cells)");
+      }
+    }
+  }
+}
+
 std::vector<CampaignCell> CampaignCells(const CampaignParams& campaign) {
+  CheckDistinctValues(campaign);
   // Start with one cell per world (or one without a world), then multiply by
   // each axis in turn.
   std::vector<CampaignCell> cells;
@@ -148,7 +180,7 @@ std::string CampaignTableCsv(const std::vector<CampaignCell>& cells,
                              const std::vector<nlohmann::json>& summaries) {
   std::string csv = "cell";
   if (!cells.empty()) {
-    for (const auto& [label, value] : cells.front().labels) csv += "," + label;
+    for (const auto& [label, value] : cells.front().labels) csv += "," + rundir::CsvField(label);
   }
   csv += ",runs";
   for (const std::string& f : rundir::FilterNames()) {
@@ -158,8 +190,8 @@ std::string CampaignTableCsv(const std::vector<CampaignCell>& cells,
   csv += "\n";
   for (std::size_t c = 0; c < cells.size(); ++c) {
     const nlohmann::json& s = summaries[c];
-    csv += cells[c].name;
-    for (const auto& [label, value] : cells[c].labels) csv += "," + value;
+    csv += rundir::CsvField(cells[c].name);
+    for (const auto& [label, value] : cells[c].labels) csv += "," + rundir::CsvField(value);
     csv += "," + std::to_string(s["sweep"].value("completed_runs", 0));
     for (const std::string& f : rundir::FilterNames()) {
       for (const FilterColumn& column : kFilterColumns) {

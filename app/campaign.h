@@ -5,6 +5,7 @@
 // in a small YAML file (`mjslam sweep --campaign FILE`) or with repeated
 // options (`--world W`, `--vary KEY=V1,V2`); docs/commands.md, "Campaigns".
 
+#include <cstddef>
 #include <string>
 #include <utility>
 #include <vector>
@@ -80,8 +81,18 @@ CampaignParams LoadCampaign(const std::string& path);
 CampaignParams CampaignFromOptions(const std::vector<std::string>& worlds,
                                    const std::vector<std::string>& vary);
 
+/// The number of cells of the grid (worlds x the values of each axis),
+/// counted without making them; `limit` + 1 when there are more than
+/// `limit`.
+std::size_t CampaignCellCount(const CampaignParams& campaign, std::size_t limit);
+
+/// Throws std::runtime_error naming the axis when two of its values mean the
+/// same (the same text, or the same number: 10, 10.0, 1e1).
+void CheckDistinctValues(const CampaignParams& campaign);
+
 /// The cells of the grid, worlds outermost, then the axes in order (the last
-/// varies fastest). Throws std::runtime_error when two cells get one name.
+/// varies fastest). Throws std::runtime_error when two cells get one name or
+/// an axis repeats a value (CheckDistinctValues).
 std::vector<CampaignCell> CampaignCells(const CampaignParams& campaign);
 
 /// The table across cells from each cell's sweep summary.json (`summaries`,

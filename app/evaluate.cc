@@ -56,8 +56,9 @@ std::vector<eval::DivergenceStatistics> StudyRunMaps(const std::string& run_dir,
 }  // namespace
 
 eval::Map WorldGroundTruth(const std::string& world, const std::string& robot_model,
-                           const eval::GroundTruthParams& params) {
+                           const eval::GroundTruthParams& params, double max_world_extent_m) {
   const sim::Scene scene(world, robot_model);
+  sim::CheckWorldExtent(scene, max_world_extent_m);
   std::vector<eval::WallRectangle> walls;
   for (const sim::ObstacleFootprint& obstacle : scene.Obstacles()) {
     if (obstacle.shape != sim::ObstacleFootprint::Shape::kRectangle) continue;
@@ -79,7 +80,8 @@ eval::Map RunGroundTruth(const std::string& run_dir, const eval::GroundTruthPara
     throw std::runtime_error(config_path + ": missing (is '" + run_dir + "' a run directory?)");
   }
   const RunConfig config = LoadRunConfig(config_path, {});
-  return WorldGroundTruth(config.run.world, config.run.robot_model, params);
+  return WorldGroundTruth(config.run.world, config.run.robot_model, params,
+                          config.sim.max_world_extent_m);
 }
 
 std::vector<eval::PoseStepMetrics> PoseSteps(const CsvTable& trajectory, const std::string& name) {

@@ -11,6 +11,7 @@
 #include "eval/map_matching.h"
 #include "eval/map_types.h"
 #include "eval/pose_metrics.h"
+#include "sim/sim_params.h"
 
 namespace mjslam::app {
 
@@ -62,9 +63,11 @@ struct RunEvaluation {
 /// eval::BuildGroundTruthMap, restricted to the features that face the free
 /// space reachable from the world's start site (eval::ReachableFeatures);
 /// pillars (round or other non-box geoms) are left out. Throws naming the
-/// world when it cannot be loaded or a wall is not a rectangle.
+/// world when it cannot be loaded, spans more than `max_world_extent_m`
+/// (sim::CheckWorldExtent) or a wall is not a rectangle.
 eval::Map WorldGroundTruth(const std::string& world, const std::string& robot_model,
-                           const eval::GroundTruthParams& params = {});
+                           const eval::GroundTruthParams& params = {},
+                           double max_world_extent_m = sim::SimParams{}.max_world_extent_m);
 
 /// WorldGroundTruth of the world in the run's config.yaml. Throws naming the
 /// file when the run directory's config or world cannot be loaded.

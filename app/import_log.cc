@@ -9,6 +9,8 @@
 
 #include "app/replay.h"
 #include "app/version.h"
+#include "common/interrupt.h"
+#include "common/params.h"
 #include "config/config.h"
 #include "realdata/relations.h"
 #include "rundir/csv_writer.h"
@@ -174,9 +176,74 @@ std::vector<double> SlamRanges(const LaserMessage& scan) {
   return ranges;
 }
 
-// scans.csv (no true laser pose) and reference.csv; trajectory.csv's
-// recorded columns, one row per odometry message and per scan in time order.
-int WriteRecording(const Stream& s, const std::string& dir) {
+// The log's timestamps must be at most this, seconds (UNIX time in the year
+// 2286): a later one is a corrupt stamp.
+constexpr double kMaxLogTimeS = 1e10;
+
+// One row of trajectory.csv's recorded columns, and the log line it is from.
+struct RecordedRow {
+  double t_s = 0.0;
+  Pose2 X_WR;
+  double tv_mps = 0.0;
+  double rv_radps = 0.0;
+  int line = 0;
+};
+
+// Throws "LOG:LINE: ..." unless `value` is finite and within +-`limit`:
+// what the run directory's readers would refuse later, naming their own
+// file's line instead of the log's.
+void CheckLogValue(const std::string& log_path, int line, const char* what, double value,
+                   double limit) {
+  if (std::isfinite(value) && std::abs(value) <= limit) return;
+  char text[160];
+  std::snprintf(text, sizeof(text), ": %s: expected a number in [-%g, %g] (got %g)", what, limit,
+                limit, value);
+  throw std::runtime_error(log_path + ":" + std::to_string(line) + text);
+}
+
+// trajectory.csv's recorded columns, one row per odometry message and per
+// scan in time order, each checked against the readers' limits.
+std::vector<RecordedRow> RecordedRows(const Stream& s, const std::string& log_path) {
+  constexpr double kMax = rundir::kMaxRecordedCoordinateM;
+  std::vector<RecordedRow> rows;
+  std::size_t o = 0, k = 0;
+  const OdometryMessage* last = &s.odometry.front();
+  const double end = std::numeric_limits<double>::infinity();
+  while (o < s.odometry.size() || k < s.scans.size()) {
+    const double t_odom = o < s.odometry.size() ? s.odometry[o].t_s : end;
+    const double t_scan = k < s.scans.size() ? s.scans[k]->t_s : end;
+    const double t = std::min(t_odom, t_scan);
+    if (t_odom == t) last = &s.odometry[o++];
+    if (t_scan == t) ++k;
+    const LaserMessage* scan = t_scan == t ? s.scans[k - 1] : nullptr;
+    const Pose2 X_OB = scan != nullptr && scan->has_odometry_at_scan
+                           ? scan->odometry_at_scan
+                           : OdometryAt(s.odometry, t);
+    RecordedRow row{t, s.X_WO * X_OB * s.X_BR, last->tv_mps, last->rv_radps,
+                    scan != nullptr ? scan->line : last->line};
+    CheckLogValue(log_path, row.line, "timestamp, s", t, kMaxLogTimeS);
+    CheckLogValue(log_path, row.line, "odometry x, m", row.X_WR.x, kMax);
+    CheckLogValue(log_path, row.line, "odometry y, m", row.X_WR.y, kMax);
+    CheckLogValue(log_path, row.line, "odometry theta, rad", row.X_WR.theta, kMax);
+    CheckLogValue(log_path, last->line, "translational velocity, m/s", row.tv_mps, kMax);
+    CheckLogValue(log_path, last->line, "rotational velocity, rad/s", row.rv_radps, kMax);
+    rows.push_back(row);
+    if (rows.size() % 4096 == 0) ThrowIfInterrupted("import");
+  }
+  for (const LaserMessage* scan : s.scans) {
+    CheckLogValue(log_path, scan->line, "maximum range, m", scan->max_range_m, kMax);
+    if (!s.has_reference) continue;
+    const Pose2 X_WR = scan->laser_pose * s.X_BS.Inverse() * s.X_BR;
+    CheckLogValue(log_path, scan->line, "laser pose x, m", X_WR.x, kMax);
+    CheckLogValue(log_path, scan->line, "laser pose y, m", X_WR.y, kMax);
+    CheckLogValue(log_path, scan->line, "laser pose theta, rad", X_WR.theta, kMax);
+  }
+  return rows;
+}
+
+// scans.csv (no true laser pose), reference.csv and trajectory.csv's
+// recorded columns (`rows`).
+int WriteRecording(const Stream& s, const std::vector<RecordedRow>& rows, const std::string& dir) {
   const int num_beams = static_cast<int>(s.scans.front()->ranges_m.size());
   const double nan = std::numeric_limits<double>::quiet_NaN();
   rundir::CsvWriter scans(rundir::PathIn(dir, rundir::kScansFile), rundir::ScanColumns(num_beams));
@@ -194,31 +261,17 @@ int WriteRecording(const Stream& s, const std::string& dir) {
   }
   rundir::CsvWriter trajectory(rundir::PathIn(dir, rundir::kTrajectoryFile),
                                rundir::RecordedTrajectoryColumns());
-  std::size_t o = 0, k = 0;
-  int rows = 0;
-  const OdometryMessage* last = &s.odometry.front();
-  while (o < s.odometry.size() || k < s.scans.size()) {
-    const double t_odom = o < s.odometry.size() ? s.odometry[o].t_s : 1e300;
-    const double t_scan = k < s.scans.size() ? s.scans[k]->t_s : 1e300;
-    const double t = std::min(t_odom, t_scan);
-    if (t_odom == t) last = &s.odometry[o++];
-    if (t_scan == t) ++k;
-    const LaserMessage* scan = t_scan == t ? s.scans[k - 1] : nullptr;
-    const Pose2 X_OB = scan != nullptr && scan->has_odometry_at_scan
-                           ? scan->odometry_at_scan
-                           : OdometryAt(s.odometry, t);
-    const Pose2 X_WR = s.X_WO * X_OB * s.X_BR;
-    for (double value : {t, nan, nan, nan, X_WR.x, X_WR.y, X_WR.theta, last->tv_mps,
-                         last->rv_radps}) {
+  for (const RecordedRow& row : rows) {
+    for (double value : {row.t_s, nan, nan, nan, row.X_WR.x, row.X_WR.y, row.X_WR.theta,
+                         row.tv_mps, row.rv_radps}) {
       trajectory.Add(value);
     }
     trajectory.EndRow();
-    ++rows;
   }
   scans.Flush();
   trajectory.Flush();
   if (reference) reference->Flush();
-  return rows;
+  return static_cast<int>(rows.size());
 }
 
 // The manifest of an imported run: the source, the layout, the counts, the
@@ -263,6 +316,7 @@ CarmenLog ReadLog(const ImportOptions& options) {
   if (format != "auto" && format != "carmen" && format != "breezyslam") {
     throw std::runtime_error("--format: expected auto, carmen or breezyslam (got '" + format + "')");
   }
+  realdata::RequireRegularFile(options.log_path);
   realdata::BreezySlamOptions breezyslam = options.breezyslam;
   if (options.read.max_range_m > 0.0) breezyslam.max_range_m = options.read.max_range_m;
   if (format == "breezyslam" ||
@@ -277,6 +331,7 @@ CarmenLog ReadLog(const ImportOptions& options) {
 // Reads the log, sets the config's laser from it, writes the recording and
 // the manifest, then replays the recording into the same directory.
 ImportReport ImportLog(RunConfig config, const ImportOptions& options) {
+  CheckImportOptions(options);
   const CarmenLog log = ReadLog(options);
   const std::vector<LaserMessage>& all_scans = ChooseLaser(log, options.laser);
   CheckSameLayout(log, all_scans);
@@ -329,9 +384,20 @@ ImportReport ImportLog(RunConfig config, const ImportOptions& options) {
   if (!options.relations_path.empty() && !std::isfinite(report.time_offset_s)) {
     std::vector<realdata::TimedPose> scan_times;
     for (const LaserMessage* scan : s.scans) scan_times.push_back({scan->t_s, Pose2()});
-    report.time_offset_s = realdata::BestTimeOffset(realdata::ReadRelations(options.relations_path),
-                                                    scan_times, options.tolerance_s, nullptr);
+    try {
+      report.time_offset_s =
+          realdata::BestTimeOffset(realdata::ReadRelations(options.relations_path), scan_times,
+                                   options.tolerance_s, nullptr, options.max_offset_candidates);
+    } catch (const std::length_error& error) {
+      throw std::runtime_error("--relations " + options.relations_path + ": " + error.what() +
+                               " (--max-offset-candidates " +
+                               std::to_string(options.max_offset_candidates) +
+                               "): give the offset with --time-offset");
+    }
   }
+  // Every value checked before anything is written.
+  const std::vector<RecordedRow> rows = RecordedRows(s, log.path);
+  if (options.check_only) return report;
 
   const std::string& dir = options.out_dir;
   const rundir::RunDirectoryLock lock(dir);
@@ -339,10 +405,42 @@ ImportReport ImportLog(RunConfig config, const ImportOptions& options) {
   rundir::ManifestWriter manifest(dir, ManifestFields(options, report, first, s, log.reanchored));
   manifest.SetLaserMount(s.X_BR.Inverse() * s.X_BS);
   manifest.Write();
-  report.num_steps = WriteRecording(s, dir);
+  try {
+    report.num_steps = WriteRecording(s, rows, dir);
+    ThrowIfInterrupted("import");
+  } catch (const Interrupted&) {
+    manifest.Finish("interrupted");
+    throw;
+  } catch (const std::exception& error) {
+    manifest.Fail(error.what());
+    throw;
+  }
   const rundir::Recording recording(rundir::PathIn(dir, rundir::kScansFile), "", num_beams);
-  ReplayRecording(config, recording, dir, &manifest);
+  report.interrupted = !ReplayRecording(config, recording, dir, &manifest);
   return report;
+}
+
+void CheckImportOptions(const ImportOptions& o) {
+  auto refuse = [](const std::string& option, double value, const std::string& expected) {
+    throw std::runtime_error(option + ": expected " + expected + " (got " + ValueText(value) + ")");
+  };
+  const auto& r = o.read;
+  if (!(std::abs(r.angle_min_deg) <= 360.0)) refuse("--angle-min-deg", r.angle_min_deg, "degrees in [-360, 360]");
+  if (!(r.angle_step_deg >= 0.0 && r.angle_step_deg <= 360.0)) {
+    refuse("--angle-step-deg", r.angle_step_deg, "degrees in [0, 360] (0: from the beam count)");
+  }
+  if (!(r.max_range_m >= 0.0 && r.max_range_m <= rundir::kMaxRecordedCoordinateM)) {
+    refuse("--max-range", r.max_range_m, "metres in [0, 1e6] (0: from the log)");
+  }
+  if (!std::isnan(o.laser_offset_m) && !(std::abs(o.laser_offset_m) <= 100.0)) {
+    refuse("--laser-offset", o.laser_offset_m, "metres in [-100, 100]");
+  }
+  if (!std::isnan(o.time_offset_s) && !std::isfinite(o.time_offset_s)) {
+    refuse("--time-offset", o.time_offset_s, "a finite number of seconds, or auto");
+  }
+  if (!(o.tolerance_s > 0.0 && o.tolerance_s <= 10.0)) {
+    refuse("--tolerance", o.tolerance_s, "seconds in (0, 10]");
+  }
 }
 
 }  // namespace mjslam::app

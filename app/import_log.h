@@ -7,6 +7,7 @@
 #include "app/run_config.h"
 #include "realdata/breezyslam_log.h"
 #include "realdata/carmen_log.h"
+#include "realdata/relations.h"
 
 namespace mjslam::app {
 
@@ -43,6 +44,12 @@ struct ImportOptions {
   std::string relations_path;
   double time_offset_s = std::numeric_limits<double>::quiet_NaN();
   double tolerance_s = 0.006;
+  /// The most candidate offsets (relation times x scans) the search may
+  /// hold, 8 bytes each (realdata::BestTimeOffset).
+  std::size_t max_offset_candidates = realdata::kMaxOffsetCandidates;
+  /// Read and check everything (the log, the relations, the offset search,
+  /// every value written), then return without writing (the fuzz target).
+  bool check_only = false;
 };
 
 /// What an import read and wrote, for the command's report.
@@ -57,6 +64,9 @@ struct ImportReport {
   /// restarts it at each scan (realdata::CarmenLog::reanchored).
   bool odometry_rebuilt = false;
   double time_offset_s = 0.0;
+  /// Whether a stop request ended the replay (its rows so far written, the
+  /// manifest "interrupted").
+  bool interrupted = false;
   /// realdata::SkipReport of the log, plus the scans left out by the import.
   std::vector<std::string> skipped;
   /// What the reader did to the log besides skipping lines (e.g. timestamps
@@ -77,5 +87,10 @@ struct ImportReport {
 /// placed so that it starts at the reference's first pose. Throws
 /// std::runtime_error naming the file and line of bad input.
 ImportReport ImportLog(RunConfig config, const ImportOptions& options);
+
+/// Throws std::runtime_error naming the option and its value when an option
+/// of `options` is out of its range (docs/commands.md): a NaN, a negative
+/// step or tolerance, an infinite offset.
+void CheckImportOptions(const ImportOptions& options);
 
 }  // namespace mjslam::app

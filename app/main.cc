@@ -1,6 +1,7 @@
 // mjslam: the command line. One function adds each subcommand's options and
 // one runs it; main() builds the CLI and dispatches. With the tests, the only
 // place that catches errors.
+#include <cmath>
 #include <csignal>
 #include <cstdio>
 #include <cstdlib>
@@ -174,7 +175,11 @@ int ReplayMain(ReplayCommand c, const std::string& command_line) {
   const RunConfig config = LoadRunConfig(c.config.path, c.config.overrides);
   c.options.config_path = c.config.path;
   c.options.command_line = command_line;
-  Replay(config, c.options);
+  if (!Replay(config, c.options)) {
+    std::fprintf(stderr, "%s: replay interrupted (whole rows written; manifest says interrupted)\n",
+                 c.options.out_dir.c_str());
+    return 130;
+  }
   std::fprintf(stderr, "%s: replay completed\n", c.options.out_dir.c_str());
   return 0;
 }
@@ -216,23 +221,39 @@ CLI::App* AddImport(CLI::App* cli, ImportCommand* c) {
   import->add_option("--time-offset", c->time_offset,
                      "Relation time minus log time, seconds, or auto (searched)")->capture_default_str();
   import->add_option("--tolerance", c->options.tolerance_s,
-                     "Relation time matching tolerance, seconds")->capture_default_str();
+                     "Relation time matching tolerance, seconds, in (0, 10]")->capture_default_str();
+  import->add_option("--max-offset-candidates", c->options.max_offset_candidates,
+                     "Most relation times x scans the time offset search may compare (8 bytes "
+                     "each)")
+      ->capture_default_str()
+      ->check(NonNegativeInteger());
   AddConfigOptions(import, &c->config, "Override any config key");
   return import;
 }
 
-int ImportMain(ImportCommand c, const std::string& command_line) {
+int ImportMain(const CLI::App& import, ImportCommand c, const std::string& command_line) {
+  // NaN means "from the log" inside; given on the command line it is refused.
+  if (import.count("--laser-offset") > 0 && !std::isfinite(c.options.laser_offset_m)) {
+    throw std::runtime_error("--laser-offset: expected metres in [-100, 100] (got " +
+                             ValueText(c.options.laser_offset_m) + ")");
+  }
   const RunConfig config = LoadRunConfig(c.config.path, c.config.overrides);
   c.options.config_path = c.config.path;
   c.options.command_line = command_line;
   if (c.time_offset != "auto") {
     char* end = nullptr;
     c.options.time_offset_s = std::strtod(c.time_offset.c_str(), &end);
-    if (end == c.time_offset.c_str() || *end != '\0') {
-      throw std::runtime_error("--time-offset: expected seconds or auto (got '" + c.time_offset + "')");
+    if (end == c.time_offset.c_str() || *end != '\0' || !std::isfinite(c.options.time_offset_s)) {
+      throw std::runtime_error("--time-offset: expected a finite number of seconds or auto (got '" +
+                               c.time_offset + "')");
     }
   }
   const ImportReport report = ImportLog(config, c.options);
+  if (report.interrupted) {
+    std::fprintf(stderr, "%s: import interrupted in its replay (whole rows written; manifest says "
+                 "interrupted)\n", c.options.out_dir.c_str());
+    return 130;
+  }
   std::fprintf(stderr, "%s: imported %s: %d %s scans of %d beams, %d odometry messages, %d steps, %s\n",
                c.options.out_dir.c_str(), c.options.log_path.c_str(), report.num_scans,
                report.laser.c_str(), report.num_beams, report.num_odometry, report.num_steps,
@@ -393,6 +414,13 @@ CLI::App* AddSweep(CLI::App* cli, SweepCommand* c) {
                "of such sweeps over worlds and config values; locally or on Slurm");
   AddConfigOptions(sweep, &c->config, "Override any config key");
   sweep->add_option("--runs", c->options.runs, "Number of runs (per cell of a campaign)")
+      ->check(CLI::PositiveNumber);
+  sweep->add_option("--max-cells", c->options.max_cells, "Most cells a campaign may have")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  sweep->add_option("--max-runs", c->options.max_runs,
+                    "Most runs a sweep or campaign may have in all (cells x runs)")
+      ->capture_default_str()
       ->check(CLI::PositiveNumber);
   sweep->add_option("--jobs", c->options.jobs, "local: runs at a time (0: one per core)")
       ->capture_default_str()
@@ -630,13 +658,28 @@ int main(int argc, char** argv) {
   const std::vector<std::pair<CLI::App*, std::function<int()>>> commands = {
       {app::AddRun(&cli, &run), [&] { return app::RunMain(*cli.get_subcommand("run"), run, command_line); }},
       {app::AddReplay(&cli, &replay), [&] { return app::ReplayMain(replay, command_line); }},
-      {app::AddImport(&cli, &import), [&] { return app::ImportMain(import, command_line); }},
+      {app::AddImport(&cli, &import), [&] { return app::ImportMain(*cli.get_subcommand("import"), import, command_line); }},
       {app::AddConfig(&cli, &config), [&] { return app::ConfigMain(config); }},
       {app::AddEvaluate(&cli, &evaluate), [&] { return app::EvaluateMain(evaluate); }},
       {app::AddSweep(&cli, &sweep), [&] { return app::SweepMain(*cli.get_subcommand("sweep"), sweep); }},
       {app::AddSweepTask(&cli, &sweep_task), [&] { return app::SweepTaskMain(sweep_task); }},
       {app::AddDivergence(&cli, &divergence), [&] { return app::DivergenceMain(divergence); }},
       {app::AddRender(&cli, &render), [&] { return app::RenderMain(render); }}};
+  // CLI11 takes an unknown subcommand for an extra argument and lets a
+  // --help after it print the top-level help with status 0.
+  if (argc > 1 && argv[1][0] != '-') {
+    std::string names;
+    bool known = false;
+    for (const auto& command : commands) {
+      known = known || command.first->get_name() == argv[1];
+      names += (names.empty() ? "" : ", ") + command.first->get_name();
+    }
+    if (!known) {
+      std::fprintf(stderr, "mjslam: error: unknown subcommand '%s' (expected one of %s)\n",
+                   argv[1], names.c_str());
+      return static_cast<int>(CLI::ExitCodes::RequiredError);
+    }
+  }
   CLI11_PARSE(cli, argc, argv);
 
   std::signal(SIGINT, app::RequestStop);

@@ -7,6 +7,7 @@
 
 #include "app/evaluate_real.h"
 #include "app/run_config.h"
+#include "common/interrupt.h"
 #include "renders/plan_canvas.h"
 #include "renders/video_writer.h"
 #include "rundir/csv_reader.h"
@@ -143,6 +144,7 @@ void DrawMap(const std::string& dir, const std::string& name, PlanCanvas* canvas
 void AddScans(const RealRun& run, const Track& track, std::size_t from, std::size_t to,
               PlanCanvas* canvas) {
   for (std::size_t k = from; k < to; ++k) {
+    if (k % 256 == 0) ThrowIfInterrupted("render");
     for (const Eigen::Vector2d& p : ScanPoints(run, track.prefix, k)) canvas->Dot(p, track.points);
   }
   const std::size_t first_row = from == 0 ? 0 : run.row_at.at(run.scans.rows[from - 1][0]);
@@ -186,6 +188,7 @@ int RenderImportedRun(const std::string& run_dir, const renders::RenderParams& p
   const int side = params.height - params.height % 2;
   std::vector<PlanCanvas> panels;
   for (const Track& track : Tracks()) {
+    ThrowIfInterrupted("render");
     panels.emplace_back(side, side, min, max);
     DrawReference(run, &panels.back());
     AddScans(run, track, 0, num_scans, &panels.back());
@@ -205,6 +208,8 @@ int RenderImportedRun(const std::string& run_dir, const renders::RenderParams& p
                              params.fps, params.crf);
   const std::size_t stride = (num_scans + kMaxVideoFrames - 1) / kMaxVideoFrames;
   for (std::size_t from = 0; from < num_scans; from += stride) {
+    // A stop leaves no video (the writer removes its temporary file).
+    ThrowIfInterrupted("render");
     const std::size_t to = std::min(num_scans, from + stride);
     std::vector<PlanCanvas> frame;
     for (int f = 0; f < 2; ++f) {

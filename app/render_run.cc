@@ -255,8 +255,9 @@ RenderResult RenderRun(const std::string& run_dir, const renders::RenderParams& 
   if (!fs::is_directory(dir)) throw std::runtime_error("run directory not found: '" + run_dir + "'");
   const RunConfig config = LoadRunConfig((dir / rundir::kConfigFile).string(), {});
 
-  renders::SceneRenderer renderer(sim::Scene(config.run.world, config.run.robot_model), config.sim,
-                                  config.robot, params.width, params.height);
+  const sim::Scene scene(config.run.world, config.run.robot_model);
+  sim::CheckWorldExtent(scene, config.sim.max_world_extent_m);
+  renders::SceneRenderer renderer(scene, config.sim, config.robot, params.width, params.height);
   RunPlayback playback(dir, config, PixelSizeM(renderer));
   playback.frame().ellipse_scale = params.ellipse_scale;
 

@@ -6,6 +6,7 @@
 #include "app/progress.h"
 #include "app/slam_pair.h"
 #include "app/version.h"
+#include "common/interrupt.h"
 #include "config/config.h"
 #include "rundir/csv_writer.h"
 #include "rundir/layout.h"
@@ -16,7 +17,7 @@
 
 namespace mjslam::app {
 
-void Replay(const RunConfig& config, const ReplayOptions& options) {
+bool Replay(const RunConfig& config, const ReplayOptions& options) {
   config.ValidateOrThrow();
   const rundir::Recording recording(options.scans_path, options.trajectory_path,
                                     config.laser.num_beams);
@@ -30,13 +31,14 @@ void Replay(const RunConfig& config, const ReplayOptions& options) {
                                         {"git_commit", MjslamGitCommit()},
                                         {"config_file", options.config_path},
                                         {"command_line", options.command_line}});
-  ReplayRecording(config, recording, dir, &manifest);
+  return ReplayRecording(config, recording, dir, &manifest);
 }
 
-void ReplayRecording(const RunConfig& config, const rundir::Recording& recording,
+bool ReplayRecording(const RunConfig& config, const rundir::Recording& recording,
                      const std::string& dir, rundir::ManifestWriter* manifest) {
   manifest->SetLaserMount(recording.X_RS());
   manifest->Write();
+  bool interrupted = false;
   try {
     // The same loop as a run, its records read from the recording.
     ClosedLoop loop(config, recording);
@@ -44,6 +46,10 @@ void ReplayRecording(const RunConfig& config, const rundir::Recording& recording
                                  rundir::TrajectoryColumns());
     Progress progress("replay", static_cast<double>(loop.num_steps()));
     while (!loop.Done()) {
+      if (InterruptRequested()) {
+        interrupted = true;
+        break;
+      }
       const LoopStep& step = loop.Step();
       rundir::AddTrajectoryRow(step.row, &trajectory);
       progress.Update(static_cast<double>(step.index));
@@ -55,7 +61,8 @@ void ReplayRecording(const RunConfig& config, const rundir::Recording& recording
     manifest->Fail(error.what());
     throw;
   }
-  manifest->Finish("completed");
+  manifest->Finish(interrupted ? "interrupted" : "completed");
+  return !interrupted;
 }
 
 }  // namespace mjslam::app

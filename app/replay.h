@@ -28,16 +28,19 @@ struct ReplayOptions {
 /// Writes config.yaml, manifest.json, trajectory.csv (same columns as a run)
 /// and the two maps. Given the same config, the filter columns equal those
 /// of the original run except the timings. Throws std::runtime_error naming
-/// the file, line and column of bad input.
-void Replay(const RunConfig& config, const ReplayOptions& options);
+/// the file, line and column of bad input. Returns false when a stop request
+/// (common/interrupt.h) ended it: the rows so far are written, whole, and
+/// the manifest says "interrupted".
+bool Replay(const RunConfig& config, const ReplayOptions& options);
 
 /// The part of Replay after its inputs are read, for `mjslam replay` and
 /// `mjslam import`: runs both filters over `recording` and writes
 /// trajectory.csv and the maps into `dir` (locked by the caller), records
 /// the laser mount in `manifest` (so that the directory can be replayed in
 /// turn) and finishes it ("completed", or "failed" with the error, which is
-/// rethrown).
-void ReplayRecording(const RunConfig& config, const rundir::Recording& recording,
+/// rethrown). On a stop request it stops at the next step, writes the maps
+/// of the steps done, finishes the manifest "interrupted" and returns false.
+bool ReplayRecording(const RunConfig& config, const rundir::Recording& recording,
                      const std::string& dir, rundir::ManifestWriter* manifest);
 
 }  // namespace mjslam::app

@@ -13,6 +13,7 @@
 #include "app/run_pool.h"
 #include "config/config.h"
 #include "eval/chi_square.h"
+#include "common/interrupt.h"
 #include "rundir/csv_reader.h"
 #include "rundir/csv_writer.h"
 #include "rundir/layout.h"
@@ -84,7 +85,32 @@ std::vector<std::string> RunDirs(const std::string& cell_dir, int runs) {
 // The folder of a cell recorded in sweep.json ("." for a plain sweep).
 std::string CellDir(const std::string& out_dir, const nlohmann::json& cell) {
   const std::string relative = cell.at("dir").get<std::string>();
-  return relative == "." ? out_dir : PathIn(out_dir, relative);
+  if (relative == ".") return out_dir;
+  // A folder inside the sweep: sweep.json must not send the aggregate's
+  // writes elsewhere.
+  const fs::path path(relative);
+  bool inside = !relative.empty() && path.is_relative();
+  for (const fs::path& part : path) inside = inside && part != ".." && part != ".";
+  if (!inside) {
+    throw std::runtime_error(PathIn(out_dir, kSweepRecordFile) + ": cell dir '" + relative +
+                             "': expected a folder inside " + out_dir);
+  }
+  return PathIn(out_dir, relative);
+}
+
+// Throws unless `cells` x `runs` is within the limits of `options`.
+void CheckSweepSize(std::size_t cells, long long runs, const SweepOptions& options,
+                    const std::string& what) {
+  if (cells > static_cast<std::size_t>(options.max_cells)) {
+    throw std::runtime_error(what + ": more than " + std::to_string(options.max_cells) +
+                             " cells (--max-cells " + std::to_string(options.max_cells) + ")");
+  }
+  if (runs < 1 || static_cast<double>(cells) * static_cast<double>(runs) > options.max_runs) {
+    throw std::runtime_error(what + ": " + std::to_string(cells) + " cells x " +
+                             std::to_string(runs) + " runs: expected 1 to " +
+                             std::to_string(options.max_runs) + " runs in all (--max-runs " +
+                             std::to_string(options.max_runs) + ")");
+  }
 }
 
 // out_dir/sweep.json: what `--aggregate DIR` needs to finish the sweep
@@ -243,6 +269,7 @@ SweepResult RunCells(const std::vector<SweepCell>& cells, int runs, bool campaig
                      SweepOptions options) {
   options.runs = runs;
   const int jobs = CheckedJobs(options);
+  CheckSweepSize(cells.size(), runs, options, "sweep " + options.out_dir);
   const std::string& dir = options.out_dir;
   // A resume while the sweep still runs would start its runs beside it.
   const rundir::RunDirectoryLock lock(dir);
@@ -251,6 +278,7 @@ SweepResult RunCells(const std::vector<SweepCell>& cells, int runs, bool campaig
   // Each cell's folder and config; then every run of every cell.
   std::vector<PlannedRun> planned;
   for (const SweepCell& cell : cells) {
+    ThrowIfInterrupted("sweep preparation");
     cell.config.ValidateOrThrow();
     const std::string config_path = PrepareSweepDirectory(cell.config, cell.dir);
     const std::vector<std::string> run_dirs = RunDirs(cell.dir, runs);
@@ -287,8 +315,14 @@ SweepResult RunSweep(const RunConfig& config, const SweepOptions& options) {
 SweepResult RunCampaign(const CampaignParams& campaign, const std::string& config_path,
                         const std::vector<std::string>& overrides, const SweepOptions& options) {
   ThrowIfProblems(campaign.Validate());
+  // The grid's size before it is made (a YAML alias repeated on 9 axes is
+  // 10^9 cells).
+  const int runs = campaign.runs > 0 ? campaign.runs : options.runs;
+  CheckSweepSize(CampaignCellCount(campaign, static_cast<std::size_t>(options.max_cells)), runs,
+                 options, "campaign");
   std::vector<SweepCell> cells;
   for (const CampaignCell& cell : CampaignCells(campaign)) {
+    ThrowIfInterrupted("campaign preparation");
     std::vector<std::string> cell_overrides = overrides;
     cell_overrides.insert(cell_overrides.end(), cell.overrides.begin(), cell.overrides.end());
     RunConfig config;
@@ -299,7 +333,7 @@ SweepResult RunCampaign(const CampaignParams& campaign, const std::string& confi
     }
     cells.push_back({cell, PathIn(PathIn(options.out_dir, kCellsFolder), cell.name), config});
   }
-  return RunCells(cells, campaign.runs > 0 ? campaign.runs : options.runs, true, options);
+  return RunCells(cells, runs, true, options);
 }
 
 SweepResult AggregateSweepDirectory(const std::string& dir, const SweepOptions& options) {
@@ -312,6 +346,12 @@ SweepResult AggregateSweepDirectory(const std::string& dir, const SweepOptions& 
   SweepOptions with_dir = options;
   with_dir.out_dir = dir;
   with_dir.evaluate_runs = record.value("evaluate_runs", true);
+  if (!record.at("runs").is_number_integer() || !record.at("cells").is_array()) {
+    throw std::runtime_error(PathIn(dir, kSweepRecordFile) + ": runs or cells of the wrong type");
+  }
+  CheckSweepSize(record.at("cells").size(), record.at("runs").get<long long>(), options,
+                 PathIn(dir, kSweepRecordFile));
+  for (const nlohmann::json& c : record.at("cells")) CellDir(dir, c);
   SweepResult result;
   // The last job array: wait for it, then list what it left unfinished.
   const std::optional<SlurmSubmission> last = LatestSubmission(PathIn(dir, kSlurmFolder));

@@ -25,6 +25,11 @@ struct SweepOptions {
   /// Number of runs; run i has seed run.seed + i and lives in
   /// out_dir/runs/run_<i, 3 digits>.
   int runs = 1;
+  /// The most cells a campaign may have, and the most runs a sweep or
+  /// campaign may have in all (cells x runs): checked before any cell or run
+  /// is prepared (--max-cells, --max-runs).
+  int max_cells = 1000;
+  int max_runs = 100000;
   /// Runs at a time (separate processes); 0: one per core
   /// (std::thread::hardware_concurrency()).
   int jobs = 0;

@@ -39,6 +39,7 @@ Grid2<double> ClearanceGrid(const std::vector<sim::ObstacleFootprint>& obstacles
     const Eigen::Vector2i lo = limits.CellOf(box_lo - Eigen::Vector2d::Constant(cutoff_m));
     const Eigen::Vector2i hi = limits.CellOf(box_hi + Eigen::Vector2d::Constant(cutoff_m));
     for (int j = std::max(0, lo.y()); j <= std::min(limits.height() - 1, hi.y()); ++j) {
+      ThrowIfInterrupted("world setup (coverage grid)");
       for (int i = std::max(0, lo.x()); i <= std::min(limits.width() - 1, hi.x()); ++i) {
         clearance(i, j) =
             std::min(clearance(i, j), sim::DistanceToFootprint(limits.CellCenter(i, j), o));
@@ -95,6 +96,7 @@ TrueCoverage::TrueCoverage(const std::vector<sim::ObstacleFootprint>& obstacles,
   }
   reachable_ = Grid2<std::uint8_t>(limits_, 0);
   for (int y = 0; y < height; ++y) {
+    ThrowIfInterrupted("world setup (coverage grid)");
     for (int x = 0; x < width; ++x) {
       if (!(clearance(x, y) > kFreeMargin)) continue;
       for (const Eigen::Vector2i& offset : disk) {

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <deque>
@@ -9,6 +10,7 @@
 #include <Eigen/Core>
 
 #include "common/check.h"
+#include "common/interrupt.h"
 
 namespace mjslam {
 
@@ -81,8 +83,18 @@ class Grid2 {
   /// An empty grid.
   Grid2() = default;
   /// Every cell of `limits` set to `value`.
-  explicit Grid2(const GridLimits& limits, const T& value = T())
-      : limits_(limits), cells_(static_cast<std::size_t>(limits.num_cells()), value) {}
+  /// Filled in blocks of 2^20 cells, each after a look at the stop request
+  /// (a large grid's first touch of its memory takes seconds): throws
+  /// Interrupted (common/interrupt.h).
+  explicit Grid2(const GridLimits& limits, const T& value = T()) : limits_(limits) {
+    const std::size_t n = static_cast<std::size_t>(limits.num_cells());
+    cells_.reserve(n);
+    constexpr std::size_t kBlock = std::size_t{1} << 20;
+    for (std::size_t done = 0; done < n; done += kBlock) {
+      ThrowIfInterrupted("grid allocation");
+      cells_.insert(cells_.end(), std::min(kBlock, n - done), value);
+    }
+  }
 
   /// The grid's limits.
   const GridLimits& limits() const { return limits_; }
@@ -118,7 +130,9 @@ enum class Connectivity {
 /// `reached` and `passable(ix, iy)`, and marks it. Cells already marked in
 /// `reached` on entry are walls too, so successive fills into one `reached`
 /// grid find disjoint regions. Returns the linear indices of the cells
-/// reached by this fill, in the order of the breadth-first visit.
+/// reached by this fill, in the order of the breadth-first visit. Throws
+/// Interrupted (common/interrupt.h) on a stop request (checked every 2^16
+/// cells, a few milliseconds).
 template <typename Passable>
 std::vector<int> FloodFill(const Eigen::Vector2i& start, Connectivity connectivity,
                            const Passable& passable, Grid2<std::uint8_t>* reached) {
@@ -140,6 +154,7 @@ std::vector<int> FloodFill(const Eigen::Vector2i& start, Connectivity connectivi
     const int c = queue.front();
     queue.pop_front();
     visited.push_back(c);
+    if ((visited.size() & 0xFFFF) == 0) ThrowIfInterrupted("flood fill");
     const Eigen::Vector2i cell = limits.CellOfIndex(c);
     for (int k = 0; k < num_neighbours; ++k) {
       const int nx = cell.x() + dx[k];

@@ -26,7 +26,13 @@ struct Target {
 /// accepted one must write back as YAML that reads to the same YAML),
 /// trajectory (ReadTrajectoryCsv; accepted: increasing finite times, finite
 /// poses), scans (ReadScansCsv; accepted: ranges finite and >= 0), map
-/// (ReadMapCsv; accepted: finite features), explorer (ReadExplorerCsv).
+/// (ReadMapCsv; accepted: finite features), explorer (ReadExplorerCsv),
+/// import (a CARMEN log and its relations through app::ImportLog without
+/// writing; accepted: scans, a bounded skip report, a finite offset),
+/// campaign (LoadCampaign and CampaignCells within 1000 cells; accepted:
+/// distinct folders inside the campaign, campaign.csv of whole rows), world
+/// (footprint lines through sim::CheckWorldExtent and sim::BoxGrid;
+/// accepted: a grid of bounded size holding every box).
 /// A check of an accepted input that fails throws std::logic_error.
 const std::vector<Target>& Targets();
 

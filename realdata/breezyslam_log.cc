@@ -7,6 +7,8 @@
 #include <stdexcept>
 #include <vector>
 
+#include "common/interrupt.h"
+
 namespace mjslam::realdata {
 namespace {
 
@@ -23,8 +25,8 @@ long long Integer(const std::vector<std::string>& tokens, int i) {
   char* end = nullptr;
   const long long value = std::strtoll(text.c_str(), &end, 10);
   if (end == text.c_str() || *end != '\0') {
-    throw std::runtime_error("field " + std::to_string(i) + ": expected an integer (got '" + text +
-                             "')");
+    throw std::runtime_error("field " + std::to_string(i) + ": expected an integer (got '" +
+                             Shown(text) + "')");
   }
   return value;
 }
@@ -43,6 +45,7 @@ int BreezySlamFieldsPerLine(int num_beams) { return kFieldsBeforeRanges + num_be
 
 CarmenLog ReadBreezySlamLog(const std::string& path, const BreezySlamOptions& options) {
   CheckOptions(path, options);
+  RequireRegularFile(path);
   std::ifstream in(path);
   if (!in) throw std::runtime_error(path + ": cannot open");
   CarmenLog log;
@@ -59,9 +62,14 @@ CarmenLog ReadBreezySlamLog(const std::string& path, const BreezySlamOptions& op
   std::string line;
   while (std::getline(in, line)) {
     const int line_number = ++log.num_lines;
+    if (line_number % 1024 == 0) ThrowIfInterrupted("reading the log");
+    const std::string where = path + ":" + std::to_string(line_number) + ": ";
+    if (line.size() > kMaxLogLineBytes) {
+      throw std::runtime_error(where + "line longer than " + std::to_string(kMaxLogLineBytes) +
+                               " bytes (not a log?)");
+    }
     const std::vector<std::string> tokens = SplitLogFields(line);
     if (tokens.empty()) continue;
-    const std::string where = path + ":" + std::to_string(line_number) + ": ";
     if (static_cast<int>(tokens.size()) != fields) {
       throw std::runtime_error(where + "expected " + std::to_string(fields) + " fields for " +
                                std::to_string(options.num_beams) + " beams (got " +
@@ -94,7 +102,7 @@ CarmenLog ReadBreezySlamLog(const std::string& path, const BreezySlamOptions& op
       throw std::runtime_error(where + e.what());
     }
     if (!log.odometry.empty() && !(odom.t_s > log.odometry.back().t_s)) {
-      throw std::runtime_error(where + "timestamp " + tokens[0] +
+      throw std::runtime_error(where + "timestamp " + Shown(tokens[0]) +
                                " us not after the line before's");
     }
     odom.pose = pose;
@@ -115,6 +123,7 @@ CarmenLog ReadBreezySlamLog(const std::string& path, const BreezySlamOptions& op
 }
 
 bool LooksLikeBreezySlamLog(const std::string& path, const BreezySlamOptions& options) {
+  RequireRegularFile(path);
   std::ifstream in(path);
   std::string line;
   if (!in || !std::getline(in, line)) return false;

@@ -1,12 +1,16 @@
 #include "realdata/carmen_log.h"
 
+#include <sys/stat.h>
 #include <zlib.h>
 
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <memory>
 #include <sstream>
 #include <stdexcept>
+
+#include "common/interrupt.h"
 
 namespace mjslam::realdata {
 namespace {
@@ -18,6 +22,14 @@ constexpr double kDegToRad = kPi / 180.0;
 constexpr double kSickNoReturnM = 81.83;
 // The first malformed lines kept verbatim in CarmenLog::bad_lines.
 constexpr std::size_t kMaxBadLinesKept = 5;
+// Skip reasons kept apart; the lines of further unknown message names are
+// counted together (a garbage file must not make an unbounded report).
+constexpr std::size_t kMaxSkipReasons = 40;
+// A message stamped this far ahead of the next one of its stream, which
+// follows the one before it, is a corrupt stamp (Keep).
+constexpr double kCorruptLeadS = 3600.0;
+// Lines read between two looks at a stop request.
+constexpr int kLinesPerInterruptCheck = 1024;
 
 // A malformed line: its message, without the file and line.
 struct BadLine : std::runtime_error {
@@ -27,32 +39,46 @@ struct BadLine : std::runtime_error {
 // Reads the lines of a plain or gzip file (zlib passes plain files through).
 class LineReader {
  public:
-  explicit LineReader(const std::string& path) : file_(gzopen(path.c_str(), "rb"), gzclose) {
+  explicit LineReader(const std::string& path) : file_(nullptr, gzclose), path_(path) {
+    RequireRegularFile(path);
+    file_.reset(gzopen(path.c_str(), "rb"));
     if (!file_) throw std::runtime_error(path + ": cannot open");
-    path_ = path;
   }
-  bool Next(std::string* line) {
+  // The next line, without its line end; false at the end of the file. A
+  // line longer than kMaxLogLineBytes is read to its end and returned empty
+  // with *too_long set.
+  bool Next(std::string* line, bool* too_long) {
     line->clear();
+    *too_long = false;
+    if (++lines_ % kLinesPerInterruptCheck == 0) ThrowIfInterrupted("reading the log");
     char buffer[1 << 16];
     while (gzgets(file_.get(), buffer, sizeof(buffer)) != nullptr) {
       line->append(buffer);
-      if (!line->empty() && line->back() == '\n') {
+      const bool ends = !line->empty() && line->back() == '\n';
+      if (line->size() > kMaxLogLineBytes) {
+        *too_long = true;
+        line->clear();
+        if (ends) return true;
+        ThrowIfInterrupted("reading the log");
+        continue;
+      }
+      if (ends) {
         line->pop_back();
         if (!line->empty() && line->back() == '\r') line->pop_back();
         return true;
       }
     }
+    // zlib's Z_BUF_ERROR here is a gzip stream cut short: an error too.
     int error = Z_OK;
     const char* message = gzerror(file_.get(), &error);
-    if (error != Z_OK && error != Z_BUF_ERROR) {
-      throw std::runtime_error(path_ + ": cannot read: " + message);
-    }
-    return !line->empty();  // a last line without a line end
+    if (error != Z_OK) throw std::runtime_error(path_ + ": cannot read: " + message);
+    return !line->empty() || *too_long;  // a last line without a line end
   }
 
  private:
   std::unique_ptr<gzFile_s, int (*)(gzFile)> file_;
   std::string path_;
+  long long lines_ = 0;
 };
 
 // Reads the message fields of one line, each checked.
@@ -62,28 +88,29 @@ class Fields {
   std::size_t size() const { return tokens_.size(); }
   double Number(std::size_t i) const {
     if (i >= tokens_.size()) {
-      throw BadLine(tokens_[0] + ": field " + std::to_string(i) + " missing (truncated line?)");
+      throw BadLine(Shown(tokens_[0]) + ": field " + std::to_string(i) +
+                    " missing (truncated line?)");
     }
     const std::string& text = tokens_[i];
     char* end = nullptr;
     const double value = std::strtod(text.c_str(), &end);
     if (end == text.c_str() || *end != '\0' || !std::isfinite(value)) {
-      throw BadLine(tokens_[0] + ": field " + std::to_string(i) + ": expected a number (got '" +
-                    text + "')");
+      throw BadLine(Shown(tokens_[0]) + ": field " + std::to_string(i) +
+                    ": expected a number (got '" + Shown(text) + "')");
     }
     return value;
   }
   int Count(std::size_t i) const {
     const double value = Number(i);
     if (value < 0 || value > 100000 || value != std::floor(value)) {
-      throw BadLine(tokens_[0] + ": field " + std::to_string(i) +
-                    ": expected a count (got '" + tokens_[i] + "')");
+      throw BadLine(Shown(tokens_[0]) + ": field " + std::to_string(i) +
+                    ": expected a count (got '" + Shown(tokens_[i]) + "')");
     }
     return static_cast<int>(value);
   }
   void ExpectSize(std::size_t expected, const std::string& what) const {
     if (tokens_.size() != expected) {
-      throw BadLine(tokens_[0] + ": expected " + std::to_string(expected) + " fields " + what +
+      throw BadLine(Shown(tokens_[0]) + ": expected " + std::to_string(expected) + " fields " + what +
                     " (got " + std::to_string(tokens_.size()) + "; truncated line?)");
     }
   }
@@ -206,14 +233,41 @@ class OdometryChain {
   bool started_ = false;
 };
 
+// Counts a skipped line under `reason`; past kMaxSkipReasons reasons, under
+// one shared reason.
+void CountSkip(const std::string& reason, CarmenLog* log) {
+  const bool known = log->skipped.count(reason) > 0 || log->skipped.size() < kMaxSkipReasons;
+  ++log->skipped[known ? reason : "other lines: not read"];
+}
+
 // Keeps a message whose timestamp is positive and not before the last one
-// kept (equal ones are spread afterwards: SpreadTies).
+// kept (equal ones are spread afterwards: SpreadTies). A message before the
+// last one kept but not before the one kept ahead of it shows the last one
+// kept, and more than kCorruptLeadS after it, shows the last one kept to be
+// a corrupt stamp in the future: that one is dropped instead (else it would
+// drop the rest of the stream), and reported. (The corrected logs' clock
+// steps back by up to a second: those messages are skipped, as before.)
 template <typename Message>
 void Keep(Message message, const std::string& kind, std::vector<Message>* stream, CarmenLog* log) {
+  const std::size_t n = stream->size();
   if (message.t_s <= 0.0) {
     ++log->skipped[kind + ": timestamp <= 0"];
-  } else if (!stream->empty() && message.t_s < stream->back().t_s) {
-    ++log->skipped[kind + ": timestamp before the previous one"];
+  } else if (n > 0 && message.t_s < stream->back().t_s) {
+    if (n >= 2 && message.t_s >= (*stream)[n - 2].t_s &&
+        stream->back().t_s - message.t_s > kCorruptLeadS) {
+      const Message& future = stream->back();
+      ++log->skipped[kind + ": timestamp later than the next message's (corrupt?)"];
+      if (log->bad_lines.size() < kMaxBadLinesKept) {
+        char stamps[96];
+        std::snprintf(stamps, sizeof(stamps), "timestamp %.9g s, the next %s at line %d has %.9g s",
+                      future.t_s, kind.c_str(), message.line, message.t_s);
+        log->bad_lines.push_back(log->path + ":" + std::to_string(future.line) + ": " + kind +
+                                 ": " + stamps);
+      }
+      stream->back() = std::move(message);
+    } else {
+      ++log->skipped[kind + ": timestamp before the previous one"];
+    }
   } else {
     stream->push_back(std::move(message));
   }
@@ -249,6 +303,21 @@ void SpreadTies(const std::string& kind, std::vector<Message>* stream, CarmenLog
 
 }  // namespace
 
+void RequireRegularFile(const std::string& path) {
+  struct stat info {};
+  if (::stat(path.c_str(), &info) != 0) throw std::runtime_error(path + ": cannot open");
+  if (!S_ISREG(info.st_mode)) {
+    throw std::runtime_error(path + ": not a regular file (a pipe, FIFO or device is read "
+                             "once and may never end): save it to a file first");
+  }
+}
+
+std::string Shown(const std::string& text) {
+  constexpr std::size_t kShown = 60;
+  if (text.size() <= kShown) return text;
+  return text.substr(0, kShown) + "... (" + std::to_string(text.size()) + " bytes)";
+}
+
 double CarmenDefaultStepDeg(int num_beams) {
   if (num_beams == 180 || num_beams == 181) return 1.0;
   if (num_beams == 360 || num_beams == 361) return 0.5;
@@ -270,14 +339,19 @@ CarmenLog ReadCarmenLog(const std::string& path, const CarmenReadOptions& option
   LaserMessage laser_seen;
   const LaserMessage* laser_just_before = nullptr;
   OdometryChain chain;
-  while (reader.Next(&line)) {
+  bool too_long = false;
+  while (reader.Next(&line, &too_long)) {
     const int line_number = ++log.num_lines;
+    if (too_long) line = "LINE_TOO_LONG";
     std::vector<std::string> tokens = SplitLogFields(line);
     if (tokens.empty() || tokens[0][0] == '#') continue;
     const std::string kind = tokens[0];
     Fields fields(std::move(tokens));
     try {
-      if (kind == "PARAM") {
+      if (too_long) {
+        throw BadLine("line longer than " + std::to_string(kMaxLogLineBytes) +
+                      " bytes (not a log?)");
+      } else if (kind == "PARAM") {
         if (fields.size() < 3) throw BadLine("PARAM: expected a name and a value");
         std::vector<std::string> pair = SplitLogFields(line);
         log.params[pair[1]] = pair[2];
@@ -314,7 +388,7 @@ CarmenLog ReadCarmenLog(const std::string& path, const CarmenReadOptions& option
         laser_just_before = laser_seen.has_poses ? &laser_seen : nullptr;
         continue;
       } else {
-        ++log.skipped[kind + ": not read"];
+        CountSkip(Shown(kind) + ": not read", &log);
       }
       odom_just_before = false;
       laser_just_before = nullptr;

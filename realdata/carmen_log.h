@@ -3,6 +3,7 @@
 // Reader of CARMEN laser logs (the text format of the CARMEN robot toolkit,
 // one message per line; plain or gzip). docs/real_data.md describes the
 // messages read and the rules below.
+#include <cstddef>
 #include <map>
 #include <string>
 #include <vector>
@@ -122,6 +123,19 @@ double CarmenDefaultStepDeg(int num_beams);
 /// the stream's next stamp (after its last stamp: its mean step), and a
 /// warning says how many (CarmenLog::warnings).
 CarmenLog ReadCarmenLog(const std::string& path, const CarmenReadOptions& options = {});
+
+/// The longest line the log readers accept, bytes (a RAWLASER line of 1081
+/// beams is about 10 KB): a longer one is a bad line.
+inline constexpr std::size_t kMaxLogLineBytes = std::size_t{1} << 20;
+
+/// Throws std::runtime_error "PATH: ..." unless `path` names a regular file:
+/// a pipe, FIFO or device can be read only once (a format sniff would eat
+/// its start) or never ends (/dev/zero).
+void RequireRegularFile(const std::string& path);
+
+/// `text` as an error message quotes it: as is up to 60 bytes, else its
+/// first 60 bytes and "... (N bytes)".
+std::string Shown(const std::string& text);
 
 /// The whitespace-separated fields of one line of a text log.
 std::vector<std::string> SplitLogFields(const std::string& line);

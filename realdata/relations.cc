@@ -9,11 +9,15 @@
 #include <stdexcept>
 
 #include "common/angles.h"
+#include "common/interrupt.h"
+#include "realdata/carmen_log.h"
 
 namespace mjslam::realdata {
 namespace {
 
 constexpr double kRadToDeg = 180.0 / 3.14159265358979323846;
+// The largest relation time, seconds (UNIX time in the year 2286).
+constexpr double kMaxRelationTimeS = 1e10;
 
 // Mean and standard deviation (n - 1) of `values`; 0 for the std below 2.
 std::pair<double, double> MeanStd(const std::vector<double>& values) {
@@ -30,6 +34,7 @@ std::pair<double, double> MeanStd(const std::vector<double>& values) {
 }  // namespace
 
 std::vector<Relation> ReadRelations(const std::string& path) {
+  RequireRegularFile(path);
   std::ifstream in(path);
   if (!in) throw std::runtime_error(path + ": cannot open");
   std::vector<Relation> relations;
@@ -37,6 +42,11 @@ std::vector<Relation> ReadRelations(const std::string& path) {
   int line_number = 0;
   while (std::getline(in, line)) {
     ++line_number;
+    if (line_number % 1024 == 0) ThrowIfInterrupted("reading the relations");
+    if (line.size() > kMaxLogLineBytes) {
+      throw std::runtime_error(path + ":" + std::to_string(line_number) + ": line longer than " +
+                               std::to_string(kMaxLogLineBytes) + " bytes (not a relations file?)");
+    }
     std::istringstream fields(line);
     std::vector<double> values;
     std::string token;
@@ -45,7 +55,7 @@ std::vector<Relation> ReadRelations(const std::string& path) {
       const double value = std::strtod(token.c_str(), &end);
       if (end == token.c_str() || *end != '\0' || !std::isfinite(value)) {
         throw std::runtime_error(path + ":" + std::to_string(line_number) +
-                                 ": expected a number (got '" + token + "')");
+                                 ": expected a number (got '" + Shown(token) + "')");
       }
       values.push_back(value);
     }
@@ -54,6 +64,16 @@ std::vector<Relation> ReadRelations(const std::string& path) {
       throw std::runtime_error(path + ":" + std::to_string(line_number) +
                                ": expected 8 numbers (t1 t2 dx dy dz droll dpitch dyaw), got " +
                                std::to_string(values.size()));
+    }
+    // Times as the logs' (UNIX time at most), poses within the run
+    // directory's limits: sums and means of them stay finite.
+    const bool times_ok = std::abs(values[0]) <= kMaxRelationTimeS && std::abs(values[1]) <= kMaxRelationTimeS;
+    bool deltas_ok = true;
+    for (std::size_t i = 2; i < 8; ++i) deltas_ok = deltas_ok && std::abs(values[i]) <= 1e6;
+    if (!times_ok || !deltas_ok) {
+      throw std::runtime_error(path + ":" + std::to_string(line_number) +
+                               ": expected times within +-1e10 s and offsets within +-1e6 (got '" +
+                               Shown(line) + "')");
     }
     Relation relation;
     relation.t1_s = values[0];
@@ -112,20 +132,33 @@ RelationErrors ScoreRelations(const std::vector<Relation>& relations,
 
 double BestTimeOffset(const std::vector<Relation>& relations,
                       const std::vector<TimedPose>& trajectory, double tolerance_s,
-                      int* num_matched_times) {
+                      int* num_matched_times, std::size_t max_candidates) {
+  if (!(tolerance_s > 0.0) || !std::isfinite(tolerance_s)) {
+    throw std::invalid_argument("relation time offset search: the tolerance must be a finite "
+                                "number of seconds > 0 (got " + std::to_string(tolerance_s) + ")");
+  }
   std::set<double> times;
   for (const Relation& relation : relations) {
     times.insert(relation.t1_s);
     times.insert(relation.t2_s);
+  }
+  // The search holds every candidate at once: refuse before allocating.
+  if (!trajectory.empty() && times.size() > max_candidates / trajectory.size()) {
+    throw std::length_error(
+        "relation time offset search: " + std::to_string(times.size()) + " relation times x " +
+        std::to_string(trajectory.size()) + " poses are more than " +
+        std::to_string(max_candidates) + " candidate offsets");
   }
   // Every relation time minus every pose time, sorted: the densest window
   // of width 2 tolerance_s is the offset most times agree on.
   std::vector<double> differences;
   differences.reserve(times.size() * trajectory.size());
   for (double t : times) {
+    ThrowIfInterrupted("relation time offset search");
     for (const TimedPose& pose : trajectory) differences.push_back(t - pose.t_s);
   }
   std::sort(differences.begin(), differences.end());
+  ThrowIfInterrupted("relation time offset search");
   std::size_t best_first = 0, best_count = 0, first = 0;
   for (std::size_t last = 0; last < differences.size(); ++last) {
     while (differences[last] - differences[first] > 2.0 * tolerance_s) ++first;

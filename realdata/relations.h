@@ -3,6 +3,7 @@
 // The relative-pose error metric of Kuemmerle et al. 2009 ("On measuring the
 // accuracy of SLAM algorithms", Autonomous Robots 27(4)) and the reader of
 // its relation files (docs/real_data.md).
+#include <cstddef>
 #include <string>
 #include <vector>
 
@@ -68,13 +69,22 @@ RelationErrors ScoreRelations(const std::vector<Relation>& relations,
                               const std::vector<TimedPose>& trajectory,
                               const RelationMatching& matching);
 
+/// The default limit of BestTimeOffset's candidates: 2.5e7 (200 MB; the
+/// Intel log's relations and scans need 8 million).
+inline constexpr std::size_t kMaxOffsetCandidates = 25'000'000;
+
 /// The time offset that makes the most relation timestamps fall within
 /// `tolerance_s` of a pose of `trajectory`: every difference between a
 /// relation time and a pose time is a candidate; the count is taken for
 /// each and the best returned (ties: the smallest offset). A search, for
 /// logs whose clock origin is unknown; its count is `*num_matched_times`.
+/// The search holds every candidate (8 bytes each): it throws
+/// std::length_error, before allocating, when relation times x poses exceed
+/// `max_candidates`, and std::invalid_argument unless `tolerance_s` is
+/// finite and > 0. Throws Interrupted (common/interrupt.h) on a stop request.
 double BestTimeOffset(const std::vector<Relation>& relations,
                       const std::vector<TimedPose>& trajectory, double tolerance_s,
-                      int* num_matched_times);
+                      int* num_matched_times,
+                      std::size_t max_candidates = kMaxOffsetCandidates);
 
 }  // namespace mjslam::realdata

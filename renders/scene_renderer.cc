@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <cstring>
 #include <mutex>
 #include <stdexcept>
@@ -341,7 +342,11 @@ void SceneRenderer::Impl::FrameView(const std::vector<sim::ObstacleFootprint>& o
 }
 
 void SceneRenderer::Impl::StartOpenGl() {
-  // OSMesa: a software OpenGL context drawing into memory.
+  // OSMesa: a software OpenGL context drawing into memory. Mesa would cache
+  // its compiled shaders under the home folder (~/.cache/mesa_shader_cache):
+  // a render writes only into its run directory (unless the user set these).
+  ::setenv("MESA_SHADER_CACHE_DISABLE", "true", 0);
+  ::setenv("MESA_GLSL_CACHE_DISABLE", "true", 0);
   const OsMesaApi& osmesa = LoadOsMesa();
   gl = osmesa.create_context_ext(OSMESA_RGBA, 24, 8, 8, nullptr);
   if (gl == nullptr) throw std::runtime_error("OSMesa: cannot create an OpenGL context");

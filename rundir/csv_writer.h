@@ -56,4 +56,9 @@ class CsvWriter {
 /// Shortest round-trip text of a double ("nan" and "inf" spelled so).
 std::string FormatDouble(double value);
 
+/// `text` as one field of a CSV line (RFC 4180): as is, or, when it holds a
+/// comma, a double quote or a line end, in double quotes with each double
+/// quote doubled.
+std::string CsvField(const std::string& text);
+
 }  // namespace mjslam::rundir

@@ -1,5 +1,6 @@
 #include "rundir/manifest.h"
 
+#include <exception>
 #include <filesystem>
 #include <fstream>
 #include <stdexcept>
@@ -48,16 +49,19 @@ void ManifestWriter::SetLaserMount(const Pose2& X_RS) {
 }
 
 void ManifestWriter::Write() const {
+  std::exception_ptr atomic_error;
   try {
     WriteJsonAtomically(path_, manifest_);
-  } catch (const std::exception& atomic_error) {
-    // No room for a second copy: reuse the old file's blocks, or report the
-    // first failure.
-    try {
-      OverwriteFile(path_, manifest_.dump(2) + "\n");
-    } catch (const std::exception&) {
-      throw atomic_error;
-    }
+    return;
+  } catch (const std::exception&) {
+    atomic_error = std::current_exception();
+  }
+  // No room for a second copy: reuse the old file's blocks, or report the
+  // first failure (whole: a copy would slice it to std::exception).
+  try {
+    OverwriteFile(path_, JsonText(manifest_));
+  } catch (const std::exception&) {
+    std::rethrow_exception(atomic_error);
   }
 }
 

@@ -50,18 +50,36 @@ void WriteFileAtomically(const std::string& path, const std::string& contents) {
 }
 
 void OverwriteFile(const std::string& path, const std::string& contents) {
+  // What was there, to put back when the new contents do not fit.
+  const bool existed = std::filesystem::exists(path);
+  const std::string old = existed ? ReadTextFile(path) : std::string();
   const int fd = ::open(path.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC, 0644);
   if (fd < 0) throw std::runtime_error(path + ": cannot write: " + std::strerror(errno));
   std::string reason = WriteAll(fd, contents);
   if (reason.empty() && ::ftruncate(fd, static_cast<off_t>(contents.size())) != 0) {
     reason = std::strerror(errno);
   }
+  if (!reason.empty() && existed) {
+    // The old contents fit in the blocks they had: best effort, nothing half-written.
+    if (::lseek(fd, 0, SEEK_SET) == 0 && WriteAll(fd, old).empty()) {
+      (void)::ftruncate(fd, static_cast<off_t>(old.size()));
+    }
+  }
   ::close(fd);
-  if (!reason.empty()) throw std::runtime_error(path + ": write failed: " + reason);
+  if (!reason.empty()) {
+    if (!existed) std::remove(path.c_str());
+    throw std::runtime_error(path + ": write failed: " + reason);
+  }
+}
+
+std::string JsonText(const nlohmann::json& value) {
+  // A byte that is not UTF-8 (a path, an argument) becomes U+FFFD instead of
+  // an exception.
+  return value.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
 }
 
 void WriteJsonAtomically(const std::string& path, const nlohmann::json& value) {
-  WriteFileAtomically(path, value.dump(2) + "\n");
+  WriteFileAtomically(path, JsonText(value));
 }
 
 std::string ReadTextFile(const std::string& path) {

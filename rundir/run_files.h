@@ -21,6 +21,10 @@ void OverwriteFile(const std::string& path, const std::string& contents);
 /// Pretty-printed JSON, written atomically.
 void WriteJsonAtomically(const std::string& path, const nlohmann::json& value);
 
+/// `value` as the run directory's JSON files hold it: indented by 2, a line
+/// end at the end; bytes that are not UTF-8 replaced by U+FFFD.
+std::string JsonText(const nlohmann::json& value);
+
 /// The whole text of a file; empty when it cannot be read.
 std::string ReadTextFile(const std::string& path);
 

@@ -377,6 +377,53 @@ std::string Scene::Description() const {
   return DescribeFiles(impl_->world_path, impl_->robot_path);
 }
 
+void CheckWorldExtent(const Scene& scene, double max_extent_m) {
+  CheckWorldExtent(scene.world_path(), scene.StartPose().translation(), scene.Obstacles(),
+                   max_extent_m);
+}
+
+void CheckWorldExtent(const std::string& world_path, const Eigen::Vector2d& start,
+                      const std::vector<ObstacleFootprint>& obstacles, double max_extent_m) {
+  Eigen::Vector2d lo = start, hi = start;
+  // The obstacle that reaches farthest from the start along an axis, for the
+  // message.
+  const ObstacleFootprint* farthest = nullptr;
+  double farthest_m = 0.0;
+  for (const ObstacleFootprint& o : obstacles) {
+    // The footprint's axis-aligned bounds: a rectangle's corners, a disc's box.
+    Eigen::Vector2d o_lo = o.X_WO.translation(), o_hi = o_lo;
+    if (o.shape == ObstacleFootprint::Shape::kRectangle) {
+      for (const Eigen::Vector2d& corner : RectangleCorners(o)) {
+        o_lo = o_lo.cwiseMin(corner);
+        o_hi = o_hi.cwiseMax(corner);
+      }
+    } else {
+      o_lo.array() -= o.radius_m;
+      o_hi.array() += o.radius_m;
+    }
+    const double distance =
+        std::max((o_hi - start).cwiseAbs().maxCoeff(), (o_lo - start).cwiseAbs().maxCoeff());
+    if (!std::isfinite(distance) || distance > farthest_m) {
+      farthest = &o;
+      farthest_m = distance;
+      if (!std::isfinite(distance)) break;
+    }
+    lo = lo.cwiseMin(o_lo);
+    hi = hi.cwiseMax(o_hi);
+  }
+  const double extent = (hi - lo).maxCoeff();
+  if (std::isfinite(farthest_m) && extent <= max_extent_m) return;
+  std::ostringstream message;
+  message << "world '" << world_path << "' spans " << extent
+          << " m, more than sim.max_world_extent_m = " << max_extent_m << " m";
+  if (farthest != nullptr) {
+    message << " (geom " << (farthest->name.empty() ? "without a name" : "'" + farthest->name + "'")
+            << " at (" << farthest->X_WO.x << ", " << farthest->X_WO.y << ") reaches "
+            << farthest_m << " m from the start)";
+  }
+  throw SimError(message.str());
+}
+
 namespace internal {
 
 ModelPtr CopyModel(const mjModel& model, const char* what) {

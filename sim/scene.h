@@ -76,4 +76,16 @@ class Scene {
   std::shared_ptr<const Impl> impl_;
 };
 
+/// Throws SimError naming the world file, the geom that lies farthest out
+/// and the key, when the footprints of the world's obstacles (by their
+/// bounding discs) and its start do not fit in an axis-aligned square of
+/// side `max_extent_m` (SimParams::max_world_extent_m), or one is not
+/// finite. Called before any grid over the world is allocated.
+void CheckWorldExtent(const Scene& scene, double max_extent_m);
+
+/// The same check of `obstacles` and `p_W_start` of the world at
+/// `world_path` (for messages).
+void CheckWorldExtent(const std::string& world_path, const Eigen::Vector2d& p_W_start,
+                      const std::vector<ObstacleFootprint>& obstacles, double max_extent_m);
+
 }  // namespace mjslam::sim

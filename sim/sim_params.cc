@@ -17,6 +17,7 @@ std::vector<ParamProblem> SimParams::Validate() const {
   check.OneOf("drive_disturbance", drive_disturbance, {"twist", "wheels"});
   check.NonNegative("command_accel_mps2", command_accel_mps2);
   check.NonNegative("command_accel_radps2", command_accel_radps2);
+  check.InRange("max_world_extent_m", max_world_extent_m, 1.0, 2000.0);
   return check.problems();
 }
 

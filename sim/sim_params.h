@@ -54,6 +54,13 @@ struct SimParams {
   /// set points jump to the command.
   double command_accel_mps2 = 0.0;
   double command_accel_radps2 = 0.0;
+  /// The largest world the program sets up, metres: the side of the
+  /// smallest axis-aligned square around every static geom's footprint and
+  /// the start. Checked when a world is loaded, before any grid over it is
+  /// allocated (the contact grid, the true coverage at 0.1 m, the ground
+  /// truth at 0.05 m: their memory grows with the square of the side, about
+  /// 1 GB at 500 m). At most 2000 (the grids' cell counts stay within int).
+  double max_world_extent_m = 500.0;
 
   template <typename Archive>
   void Serialize(Archive* a) {
@@ -65,6 +72,7 @@ struct SimParams {
     a->Visit(MJSLAM_NVP(drive_disturbance));
     a->Visit(MJSLAM_NVP(command_accel_mps2));
     a->Visit(MJSLAM_NVP(command_accel_radps2));
+    a->Visit(MJSLAM_NVP(max_world_extent_m));
   }
   std::vector<ParamProblem> Validate() const;
   void ValidateOrThrow() const { ThrowIfProblems(Validate()); }

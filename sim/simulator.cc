@@ -333,6 +333,7 @@ Simulator::Simulator(Scene scene, const SimParams& sim, const RobotParams& robot
   Impl& r = *impl_;
   r.sim = sim;
   r.robot = robot;
+  CheckWorldExtent(r.scene, sim.max_world_extent_m);
   CheckRobotParamsMatch(r.scene, robot);
   CheckWheelGainIsStable(r.scene, sim);
 

@@ -41,9 +41,12 @@ Rule RuleFor(const std::string& folder) {
   if (folder == "config") return {{"common", "config"}, false, true, false, true};
   if (folder == "sim") return {{"common", "sim"}, true, false, false, true};
   if (folder == "renders") return {kCodeFolders, true, false, true, true};
-  // The fuzz targets read inputs as the program does: config, rundir, and
-  // app's RunConfig; no MuJoCo, YAML or GL of their own.
-  if (folder == "fuzz") return {{"common", "config", "rundir", "app", "fuzz"}, false, false, false, true};
+  // The fuzz targets read inputs as the program does: config, rundir, real
+  // logs, sim's world checks and grid, and app's RunConfig, import and
+  // campaigns; no MuJoCo, YAML or GL of their own.
+  if (folder == "fuzz") {
+    return {{"common", "config", "rundir", "realdata", "sim", "app", "fuzz"}, false, false, false, true};
+  }
   return {kCodeFolders, false, false, false, true};  // app
 }
 

@@ -40,6 +40,7 @@ import argparse
 import math
 import os
 import random
+import re
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -64,6 +65,10 @@ GRID_CELL_M = 0.1
 
 class BuildingError(Exception):
     """A generated building that fails a check, or invalid arguments."""
+
+
+class OptionError(BuildingError):
+    """A bad option: reported as argparse reports its own (usage, exit 2)."""
 
 
 class Obstacle:
@@ -147,13 +152,22 @@ class Building:
                                        (hi_x - lo_x) / 2, (hi_y - lo_y) / 2))
 
 
+# The largest building side, metres (mjslam's default sim.max_world_extent_m;
+# a 200 m building takes about 15 s to generate and check), and the most
+# clutter of each kind.
+MAX_SIZE_M = 500.0
+MAX_CLUTTER = 10000
+
+
 def parse_size(text):
     try:
         w, h = (float(v) for v in text.lower().split("x"))
     except ValueError:
-        raise BuildingError(f"--size: expected WIDTHxHEIGHT in metres, e.g. 40x30 (got '{text}')")
+        raise OptionError(f"--size: expected WIDTHxHEIGHT in metres, e.g. 40x30 (got '{text}')")
     if not (w >= 8 and h >= 8):
-        raise BuildingError(f"--size: each side must be at least 8 m (got '{text}')")
+        raise OptionError(f"--size: each side must be at least 8 m (got '{text}')")
+    if not (w <= MAX_SIZE_M and h <= MAX_SIZE_M):
+        raise OptionError(f"--size: each side must be at most {MAX_SIZE_M:g} m (got '{text}')")
     return w, h
 
 
@@ -161,9 +175,10 @@ def parse_range(name, text):
     try:
         lo, hi = (float(v) for v in text.split(":"))
     except ValueError:
-        raise BuildingError(f"{name}: expected MIN:MAX in metres (got '{text}')")
-    if not (0 < lo <= hi):
-        raise BuildingError(f"{name}: expected 0 < MIN <= MAX (got '{text}')")
+        raise OptionError(f"{name}: expected MIN:MAX in metres (got '{text}')")
+    # A room narrower than a metre holds no robot (and tiny ones never end a row).
+    if not (1 <= lo <= hi <= MAX_SIZE_M):
+        raise OptionError(f"{name}: expected 1 <= MIN <= MAX <= {MAX_SIZE_M:g} (got '{text}')")
     return lo, hi
 
 
@@ -172,19 +187,28 @@ def validate(args):
     for key in ("corridor_width", "wall_thickness", "door_width"):
         v = getattr(args, key)
         if not (v > 0 and math.isfinite(v)):
-            raise BuildingError(f"--{key.replace('_', '-')}: expected a value > 0 (got {v})")
+            raise OptionError(f"--{key.replace('_', '-')}: expected a value > 0 (got {v})")
     if args.corridor_width < 2 * TOUR_CLEARANCE_M + 0.2:
-        raise BuildingError(f"--corridor-width: at least {2 * TOUR_CLEARANCE_M + 0.2:g} m for the "
+        raise OptionError(f"--corridor-width: at least {2 * TOUR_CLEARANCE_M + 0.2:g} m for the "
                             f"tour's clearance (got {args.corridor_width:g})")
     for key in ("corridors", "cross_corridors", "columns", "pillars", "free_walls"):
-        if getattr(args, key) < 0:
-            raise BuildingError(f"--{key.replace('_', '-')}: expected a count >= 0 "
-                                f"(got {getattr(args, key)})")
+        if not 0 <= getattr(args, key) <= MAX_CLUTTER:
+            raise OptionError(f"--{key.replace('_', '-')}: expected a count in [0, {MAX_CLUTTER}] "
+                              f"(got {getattr(args, key)})")
     if args.corridors < 1:
-        raise BuildingError(f"--corridors: expected at least 1 (got {args.corridors})")
+        raise OptionError(f"--corridors: expected at least 1 (got {args.corridors})")
     if not 0 <= args.hall_probability <= 1:
-        raise BuildingError(f"--hall-probability: expected a value in [0, 1] "
-                            f"(got {args.hall_probability})")
+        raise OptionError(f"--hall-probability: expected a value in [0, 1] "
+                          f"(got {args.hall_probability})")
+    if not (math.isfinite(args.rotation_deg) and abs(args.rotation_deg) <= 360):
+        raise OptionError(f"--rotation-deg: expected degrees in [-360, 360] "
+                          f"(got {args.rotation_deg})")
+    if args.wall_thickness > 10 or args.door_width > 100 or args.corridor_width > 100:
+        raise OptionError("--wall-thickness, --door-width, --corridor-width: at most 10, 100 "
+                          f"and 100 m (got {args.wall_thickness:g}, {args.door_width:g}, "
+                          f"{args.corridor_width:g})")
+    if args.name is not None and not re.fullmatch(r"[A-Za-z0-9_.-]{1,100}", args.name):
+        raise OptionError(f"--name: expected letters, digits, '_', '.' or '-' (got {args.name!r})")
 
 
 # ---------------------------------------------------------------------------
@@ -289,10 +313,10 @@ def lay_out(args):
     share = (H - k * cw) / (2 * k)  # depth of one row of rooms, walls included
     block_w = (W - m * cw) / (m + 1)
     if share < 2 * t + 2.5:
-        raise BuildingError(f"--corridors: {k} corridors leave rows of {share:.2f} m in a "
+        raise OptionError(f"--corridors: {k} corridors leave rows of {share:.2f} m in a "
                             f"{H:g} m deep building; at least {2 * t + 2.5:g} m are needed")
     if block_w < args.room_width[1] + 2 * t:
-        raise BuildingError(f"--cross-corridors: {m} cross corridors leave blocks "
+        raise OptionError(f"--cross-corridors: {m} cross corridors leave blocks "
                             f"{block_w:.2f} m long; at least {args.room_width[1] + 2 * t:g} m "
                             "(one room of the widest) are needed")
     # Outer walls (faces at 0, W and 0, H; corners joined).
@@ -665,14 +689,22 @@ def build(argv):
 def main(argv):
     try:
         args, b, w = build(argv)
+    except OptionError as e:
+        parser().error(str(e))  # usage and the message on stderr, exit 2
     except BuildingError as e:
         print(f"generate_building.py: error: {e}", file=sys.stderr)
         return 1
     text = w.xml()
     tmp = args.out + ".tmp"
-    with open(tmp, "w") as f:
-        f.write(text)
-    os.replace(tmp, args.out)
+    try:
+        with open(tmp, "w") as f:
+            f.write(text)
+        os.replace(tmp, args.out)
+    except OSError as e:
+        if os.path.exists(tmp):
+            os.remove(tmp)
+        print(f"generate_building.py: error: --out {args.out}: {e.strerror}", file=sys.stderr)
+        return 1
     print(f"{args.out}: {len(b.rooms)} rooms and halls, {len(b.obstacles)} geoms, "
           f"{len(b.tour)} waypoints, tour {tour_length(b.tour):.0f} m, clutter "
           f"{b.clutter}", file=sys.stderr)

@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "config/config_node.h"
+#include "rundir/csv_writer.h"
 
 namespace mjslam::app {
 namespace {
@@ -125,6 +126,35 @@ TEST(CampaignTest, TableHasOneRowPerCellWithItsLabelsAndVerdicts) {
   const std::string text = CampaignTableText(cells, summaries);
   EXPECT_NE(text.find("room__slam.ekf.max_updates=2"), std::string::npos) << text;
   EXPECT_NE(text.find("consistent"), std::string::npos) << text;
+}
+
+// Issue 32, item 6: a label with a comma or a quote shifted the columns of
+// campaign.csv; a world named `...xml` made its cell folder `..`; three
+// spellings of one value made three identical cells.
+TEST(CampaignTest, LabelsAreQuotedFoldersStayInsideAndValuesAreDistinct) {
+  CampaignParams campaign;
+  campaign.worlds = {"/w/a,b\"c.xml", "/w/...xml"};
+  const std::vector<CampaignCell> cells = CampaignCells(campaign);
+  ASSERT_EQ(cells.size(), 2u);
+  EXPECT_EQ(cells[1].name, "_.");  // the stem "..", no longer the folder above
+  EXPECT_EQ(cells[0].name, "a_b_c");
+  std::vector<nlohmann::json> summaries(2);
+  for (nlohmann::json& summary : summaries) summary["sweep"]["completed_runs"] = 0;
+  const std::string csv = CampaignTableCsv(cells, summaries);
+  EXPECT_NE(csv.find("\na_b_c,\"a,b\"\"c\",0,"), std::string::npos) << csv;
+  EXPECT_EQ(rundir::CsvField("plain"), "plain");
+  EXPECT_EQ(rundir::CsvField("a\nb"), "\"a\nb\"");
+
+  campaign.worlds.clear();
+  campaign.axes = {{"slam.ekf.max_updates", {"10", "10.0", "1e1"}}};
+  EXPECT_THROW(CampaignCells(campaign), std::runtime_error);
+  campaign.axes = {{"control.pose_source", {"classical", "classical"}}};
+  EXPECT_THROW(CampaignCells(campaign), std::runtime_error);
+  // The count, without making the cells.
+  campaign.axes.assign(9, {"run.seed", {"1", "2", "3", "4", "5", "6", "7", "8", "9", "10"}});
+  EXPECT_EQ(CampaignCellCount(campaign, 1000), 1001u);
+  campaign.axes.resize(2);
+  EXPECT_EQ(CampaignCellCount(campaign, 1000), 100u);
 }
 
 }  // namespace

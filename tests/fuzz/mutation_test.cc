@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <random>
@@ -26,8 +27,12 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Mutants per seed input, and the generator's seed (printed on failure).
-constexpr int kMutantsPerSeed = 500;
+// Mutants per seed input (the environment's MJSLAM_FUZZ_MUTANTS for a long
+// run, fuzz/README.md), and the generator's seed (printed on failure).
+int MutantsPerSeed() {
+  const char* text = std::getenv("MJSLAM_FUZZ_MUTANTS");
+  return text != nullptr && std::atoi(text) > 0 ? std::atoi(text) : 500;
+}
 constexpr std::uint64_t kSeed = 20261201;
 
 // Pieces a mutation inserts: separators, signs, the spellings of special
@@ -117,7 +122,8 @@ TEST_P(MutationTest, EveryMutantIsReadOrRefusedWithAnError) {
   int inputs = 0;
   for (const fs::path& seed : seeds) {
     const std::string original = ReadFile(seed);
-    for (int m = 0; m <= kMutantsPerSeed && failures < 5; ++m) {
+    const int mutants = MutantsPerSeed();
+    for (int m = 0; m <= mutants && failures < 5; ++m) {
       const std::string input = m == 0 ? original : Mutate(original, &rng);
       ++inputs;
       try {
@@ -135,7 +141,8 @@ TEST_P(MutationTest, EveryMutantIsReadOrRefusedWithAnError) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Targets, MutationTest,
-                         ::testing::Values("config", "trajectory", "scans", "map", "explorer"));
+                         ::testing::Values("config", "trajectory", "scans", "map", "explorer",
+                                           "import", "campaign", "world"));
 
 }  // namespace
 }  // namespace mjslam::fuzz

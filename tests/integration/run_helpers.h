@@ -25,8 +25,14 @@ inline std::string FreshDir(const std::string& name) {
   return dir.string();
 }
 
-/// Path of the mjslam program and of the default config.
-inline std::string Program() { return std::string(MJSLAM_BINARY_DIR) + "/mjslam"; }
+/// Path of the mjslam program (the environment's MJSLAM_TEST_PROGRAM when
+/// set: to show that a test fails with an older binary) and of the default
+/// config.
+inline std::string Program() {
+  const char* other = std::getenv("MJSLAM_TEST_PROGRAM");
+  return other != nullptr && *other != '\0' ? std::string(other)
+                                            : std::string(MJSLAM_BINARY_DIR) + "/mjslam";
+}
 inline std::string DefaultConfig() {
   return std::string(MJSLAM_SOURCE_DIR) + "/configs/default.yaml";
 }

@@ -103,5 +103,23 @@ TEST(RelationsTest, BestTimeOffsetFindsAKnownOffset) {
   EXPECT_EQ(matched, 2 * static_cast<int>(relations.size()));  // 30 distinct times
 }
 
+// Issue 32, item 2 and 4: a negative tolerance overflowed the heap (the
+// window's start ran past its end); a search larger than its limit is
+// refused before it allocates.
+TEST(RelationsTest, BestTimeOffsetRefusesABadToleranceAndTooManyCandidates) {
+  std::vector<TimedPose> scans;
+  for (int i = 0; i < 50; ++i) scans.push_back({0.37 * i, Pose2()});
+  const std::vector<Relation> relations = {{1.0, 2.0, Pose2(), 1}, {3.0, 4.0, Pose2(), 2}};
+  for (double tolerance : {-1.0, 0.0, std::nan(""), HUGE_VAL}) {
+    EXPECT_THROW(BestTimeOffset(relations, scans, tolerance, nullptr), std::invalid_argument)
+        << tolerance;
+  }
+  EXPECT_THROW(BestTimeOffset(relations, scans, 0.006, nullptr, 199), std::length_error);
+  // Times of 1e308 made the offset infinite (found by the fuzz target import).
+  EXPECT_THROW(ReadRelations(WriteFile("huge.relations", "1e308 1.5e308 0 0 0 0 0 0\n")),
+               std::runtime_error);
+  EXPECT_NO_THROW(BestTimeOffset(relations, scans, 0.006, nullptr, 200));
+}
+
 }  // namespace
 }  // namespace mjslam::realdata

@@ -12,6 +12,7 @@
 
 #include "rundir/csv_reader.h"
 #include "rundir/csv_writer.h"
+#include "rundir/manifest.h"
 
 namespace mjslam::rundir {
 namespace {
@@ -159,6 +160,51 @@ TEST(CsvTest, FullDiskLeavesWholeRowsAndNamesTheFile) {
   EXPECT_LE(text.str().size(), 10000u);
   const CsvTable table = ReadCsv(path);
   EXPECT_GT(table.rows.size(), 100u);
+}
+
+// Issue 32, item 9: a manifest that does not fit (a full disk; here a file
+// size limit of 100 bytes) left a file cut short (0 bytes on a full disk) and
+// was reported as "std::exception": now the error names the file, a new
+// manifest is not left behind and an old one keeps its contents.
+TEST(CsvTest, AManifestThatDoesNotFitIsNotLeftHalfWritten) {
+  const std::string dir = TempPath("manifest_full");
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir + "/new");
+  std::filesystem::create_directories(dir + "/old");
+  std::ofstream(dir + "/old/manifest.json") << "{\"status\": \"old\"}\n";
+  const std::string message_path = dir + "/message";
+  const pid_t child = ::fork();
+  ASSERT_GE(child, 0);
+  if (child == 0) {
+    std::signal(SIGXFSZ, SIG_IGN);
+    const rlimit limit{100, 100};
+    ::setrlimit(RLIMIT_FSIZE, &limit);
+    std::string message;
+    for (const char* sub : {"/new", "/old"}) {
+      try {
+        ManifestWriter manifest(dir + sub, {{"padding", std::string(1000, 'x')}});
+        message += "no error\n";
+      } catch (const std::exception& error) {
+        message += std::string(error.what()) + "\n";
+      }
+    }
+    std::ofstream(message_path) << message;
+    ::_exit(0);
+  }
+  int status = 0;
+  ::waitpid(child, &status, 0);
+  ASSERT_TRUE(WIFEXITED(status));
+  std::ifstream message_in(message_path);
+  std::stringstream message;
+  message << message_in.rdbuf();
+  EXPECT_NE(message.str().find(dir + "/new/manifest.json: write failed: File too large"),
+            std::string::npos) << message.str();
+  EXPECT_EQ(message.str().find("std::exception"), std::string::npos) << message.str();
+  EXPECT_FALSE(std::filesystem::exists(dir + "/new/manifest.json"));
+  std::ifstream old(dir + "/old/manifest.json");
+  std::stringstream old_text;
+  old_text << old.rdbuf();
+  EXPECT_EQ(old_text.str(), "{\"status\": \"old\"}\n");
 }
 
 }  // namespace

@@ -3,6 +3,8 @@ checks, and each kind of broken building fails with the error that names
 what is wrong (a too-narrow door, a room with no way in, a tour too close to
 a wall, a start in a wall). Run by ctest (sim_generate_building_test, label
 unit); Python 3 standard library only."""
+import contextlib
+import io
 import math
 import os
 import sys
@@ -119,6 +121,28 @@ class GenerateBuildingTest(unittest.TestCase):
                               (["--corridors", "9"], "--corridors: 9 corridors leave rows")):
             with self.assertRaisesRegex(gb.BuildingError, message):
                 gb.build(SMALL + argv + ["--out", "x.xml"])
+
+    def test_hostile_options_are_usage_errors_in_bounded_time(self):
+        # docs/reliability.md: before, --size infxinf and --room-width 0.01:0.02
+        # looped forever, nan and 'x"y' wrote a broken world with exit 0.
+        with tempfile.TemporaryDirectory() as tmp:
+            out = os.path.join(tmp, "b.xml")
+            for argv, message in ((["--size", "infxinf"], "--size: each side must be at most"),
+                                  (["--room-width", "0.01:0.02"], "--room-width: expected 1 <="),
+                                  (["--rotation-deg", "nan"], "--rotation-deg: expected degrees"),
+                                  (["--name", 'x"y'], "--name: expected letters"),
+                                  (["--columns", "1000000000"], "--columns: expected a count")):
+                with self.assertRaisesRegex(gb.OptionError, message):
+                    gb.build(SMALL + argv + ["--out", out])
+                with self.assertRaises(SystemExit) as exit_status:
+                    with contextlib.redirect_stderr(io.StringIO()):
+                        gb.main(SMALL + argv + ["--out", out])
+                self.assertEqual(exit_status.exception.code, 2, argv)
+            self.assertEqual(os.listdir(tmp), [])
+            # An --out that cannot be written: a one-line error, exit 1.
+            with contextlib.redirect_stderr(io.StringIO()) as err:
+                self.assertEqual(gb.main(SMALL + ["--out", os.path.join(tmp, "no", "b.xml")]), 1)
+            self.assertIn("--out", err.getvalue())
 
     def test_a_failed_check_writes_nothing(self):
         with tempfile.TemporaryDirectory() as tmp:

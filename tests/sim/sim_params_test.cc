@@ -62,7 +62,7 @@ TEST(SimParamsTest, SerializeVisitsEveryFieldUnderItsKey) {
                                       "wheel_speed_ki_nm_per_rad",
                                       "drive_disturbance_std_fraction",
                                       "drive_disturbance", "command_accel_mps2",
-                                      "command_accel_radps2"}));
+                                      "command_accel_radps2", "max_world_extent_m"}));
   EXPECT_EQ(Keys<RobotParams>(),
             (std::vector<std::string>{"control_point_offset_m", "wheel_radius_m", "axle_track_m",
                                       "max_wheel_speed_radps", "max_linear_speed_mps",
