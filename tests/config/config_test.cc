@@ -170,7 +170,7 @@ TEST(ConfigTest, UnknownKeySuggestsOnlyCloseMatches) {
   // A swap of neighbours is one edit; five letters allow one edit.
   EXPECT_TRUE(Contains(ErrorOf("lasre: {}\n"), "lasre: unknown key, did you mean 'laser'? (known"));
   // Two edits away from "laser" in four letters: no suggestion.
-  EXPECT_TRUE(Contains(ErrorOf("base: 1\n"), "base: unknown key (known keys: rate_hz,"));
+  EXPECT_TRUE(Contains(ErrorOf("case: 1\n"), "case: unknown key (known keys: rate_hz,"));
 }
 
 TEST(ConfigTest, DuplicateKeyRejected) {
