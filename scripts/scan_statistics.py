@@ -69,26 +69,13 @@ def read_layout(run_dir):
     """num_beams, fov_deg, max_range_m of the run's laser, from its config.yaml."""
     layout = {"num_beams": 181, "fov_deg": 180.0, "max_range_m": 30.0}
     path = os.path.join(run_dir, "config.yaml")
-    try:
-        import yaml  # python3-yaml, installed by scripts/setup.sh
-        with open(path) as f:
-            laser = (yaml.safe_load(f) or {}).get("laser", {})
-        for key in layout:
-            if key in laser:
-                layout[key] = type(layout[key])(laser[key])
-        return layout
-    except ImportError:
-        pass
-    section = None  # without PyYAML: the flat `laser:` block of a written config
+    import yaml  # python3-yaml, installed by scripts/setup.sh
     with open(path) as f:
-        for line in f:
-            if line and not line[0].isspace():
-                section = line.split(":")[0].strip()
-                continue
-            if section == "laser" and ":" in line:
-                key, value = (s.strip() for s in line.split("#")[0].split(":", 1))
-                if key in layout:
-                    layout[key] = type(layout[key])(float(value))
+        laser = (yaml.safe_load(f) or {}).get("laser", {})
+    for key in layout:
+        if key not in laser:
+            raise SystemExit("%s: laser.%s missing" % (path, key))
+        layout[key] = type(layout[key])(laser[key])
     return layout
 
 
