@@ -493,12 +493,8 @@ LaserScan Simulator::CastLaser(const LaserParams& laser,
     for (int i = 0; i < laser.num_beams; ++i) {
       const double offset = offsets == nullptr ? 0.0 : offsets[i];
       const double bearing_W = X_WS.theta + scan.BeamAngle(i) + offset;
-      const mjtNum direction[3] = {std::cos(bearing_W), std::sin(bearing_W), 0.0};
-      int geom = -1;
-      const mjtNum distance =
-          local != nullptr ? local->CastRay(*m, *d, origin, direction, laser.max_range_m)
-                           : mj_ray(m, d, origin, direction, geom_groups, 1, -1, &geom);
-      if (distance >= 0.0 && distance < laser.max_range_m) {
+      const double distance = cast(bearing_W);
+      if (distance < laser.max_range_m) {
         ranges[i] = distance;
         has_return[i] = 1;
       }
@@ -521,8 +517,8 @@ LaserScan Simulator::CastLaser(const LaserParams& laser,
           const double length = std::hypot(tx, ty);
           if (length > 0.0) {
             // |u x t| / |t| is the cosine of the angle between u and the normal.
-            const double cos_incidence =
-                std::min(std::abs(direction[0] * ty - direction[1] * tx) / length, 1.0);
+            const double cos_incidence = std::min(
+                std::abs(std::cos(bearing_W) * ty - std::sin(bearing_W) * tx) / length, 1.0);
             footprint->incidence_rad[i] = std::acos(cos_incidence);
           }
         }
