@@ -136,7 +136,7 @@ TEST_F(BadInputTest, FileCutInsideItsLastFieldIsRefused) {
 }
 
 TEST_F(BadInputTest, BadRangesAndAScansFileWithNoRowsAreRefused) {
-  for (const std::string& range : {"nan", "-0.5", "inf"}) {
+  for (const std::string range : {"nan", "-0.5", "inf"}) {
     const std::string dir = Copy("ranges");
     const std::string path = dir + "/scans.csv";
     ReplaceLine(path, 2, WithField(path, 2, 10, range));
@@ -236,13 +236,8 @@ TEST_F(BadInputTest, StopRequestEndsADivergenceStudyWithinASecond) {
             "--realisations", "100000", static_cast<char*>(nullptr));
     ::_exit(127);
   }
-  std::this_thread::sleep_for(std::chrono::milliseconds(1500));
-  ::kill(child, SIGTERM);
-  const auto signalled = std::chrono::steady_clock::now();
   int status = 0;
-  ::waitpid(child, &status, 0);
-  const double stop_s =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - signalled).count();
+  const double stop_s = StopAfter(child, 1500, &status);
   std::printf("stopped %.3f s after SIGTERM\n", stop_s);
   ASSERT_TRUE(WIFEXITED(status)) << ReadText(log);
   EXPECT_EQ(WEXITSTATUS(status), 130) << ReadText(log);

