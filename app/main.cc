@@ -15,6 +15,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "app/calibrate.h"
 #include "app/cpu_profile.h"
 #include "app/evaluate.h"
 #include "app/evaluate_real.h"
@@ -31,6 +32,7 @@
 #include "common/interrupt.h"
 #include "config/config.h"
 #include "rundir/layout.h"
+#include "rundir/run_files.h"
 
 namespace mjslam::app {
 namespace {
@@ -279,6 +281,48 @@ CLI::App* AddConfig(CLI::App* cli, ConfigOptions* c) {
 
 int ConfigMain(const ConfigOptions& c) {
   std::fputs(config::ToYaml(LoadRunConfig(c.path, c.overrides)).c_str(), stdout);
+  return 0;
+}
+
+// mjslam calibrate
+struct CalibrateCommand {
+  std::vector<std::string> run_dirs;
+  ConfigOptions config;
+  int window_records = 10;
+  std::string write;
+};
+
+CLI::App* AddCalibrate(CLI::App* cli, CalibrateCommand* c) {
+  CLI::App* calibrate = cli->add_subcommand(
+      "calibrate", "Fit the filters' odometry noise to simulated runs (their true and odometry poses)");
+  calibrate->add_option("RUN_DIR", c->run_dirs, "Run directories, or sweep directories (their runs)")
+      ->required();
+  AddConfigOptions(calibrate, &c->config, "Override any config key of the model compared");
+  calibrate->add_option("--window-records", c->window_records,
+                        "Records summed per window of the variance fit")
+      ->capture_default_str()
+      ->check(CLI::PositiveNumber);
+  calibrate->add_option("--write", c->write,
+                        "Write the fitted keys to this YAML file, with the --config file as its base");
+  return calibrate;
+}
+
+int CalibrateMain(const CalibrateCommand& c, const std::string& command_line) {
+  const RunConfig model = LoadRunConfig(c.config.path, c.config.overrides);
+  std::vector<RunMotion> runs;
+  for (const std::string& dir : RunDirectories(c.run_dirs)) runs.push_back(ReadRunMotion(dir));
+  const Calibration calibration = Calibrate(runs, model.slam.ekf, c.window_records);
+  std::fputs(CalibrationReport(calibration, model.slam.ekf).c_str(), stdout);
+  if (!c.write.empty()) {
+    namespace fs = std::filesystem;
+    const fs::path folder = fs::absolute(fs::path(c.write)).parent_path();
+    const std::string base = fs::relative(fs::absolute(c.config.path), folder).string();
+    const std::string header = "Fitted by mjslam calibrate (" + MjslamGitCommit() + ", " +
+                               rundir::UtcNow() + ") to " + std::to_string(runs.size()) +
+                               " runs:\n  " + command_line;
+    rundir::WriteFileAtomically(c.write, CalibrationYaml(calibration, base, header));
+    std::printf("\nwrote %s\n", c.write.c_str());
+  }
   return 0;
 }
 
@@ -649,6 +693,7 @@ int main(int argc, char** argv) {
   app::ImportCommand import;
   app::ConfigOptions config;
   app::EvaluateCommand evaluate;
+  app::CalibrateCommand calibrate;
   app::SweepCommand sweep;
   app::SweepTaskCommand sweep_task;
   app::DivergenceCommand divergence;
@@ -661,6 +706,7 @@ int main(int argc, char** argv) {
       {app::AddImport(&cli, &import), [&] { return app::ImportMain(*cli.get_subcommand("import"), import, command_line); }},
       {app::AddConfig(&cli, &config), [&] { return app::ConfigMain(config); }},
       {app::AddEvaluate(&cli, &evaluate), [&] { return app::EvaluateMain(evaluate); }},
+      {app::AddCalibrate(&cli, &calibrate), [&] { return app::CalibrateMain(calibrate, command_line); }},
       {app::AddSweep(&cli, &sweep), [&] { return app::SweepMain(*cli.get_subcommand("sweep"), sweep); }},
       {app::AddSweepTask(&cli, &sweep_task), [&] { return app::SweepTaskMain(sweep_task); }},
       {app::AddDivergence(&cli, &divergence), [&] { return app::DivergenceMain(divergence); }},

@@ -230,11 +230,15 @@ MotionInput EkfSlam::CheckedMotionInput(const SensorRecord& record) const {
     RequireFinite(record.command.w_radps, "record.command.w_radps");
     input = CommandInput(record.command, record.dt_s, params_.command_noise, previous_command_);
   }
-  const double slip_std = params_.lateral_slip_std_m_per_rad * std::abs(input.increment.y());
-  input.lateral_variance_m2 = slip_std * slip_std;
+  const double turn_slip_std = params_.lateral_slip_std_m_per_rad * std::abs(input.increment.y());
+  const double roll_slip_std = params_.lateral_slip_std_m_per_sqrt_m;
+  input.lateral_variance_m2 =
+      turn_slip_std * turn_slip_std + roll_slip_std * roll_slip_std * std::abs(input.increment.x());
   if (record.dt_s > 0.0) input.skid_per_m_rad = params_.lateral_skid_s / record.dt_s;
   input.integration = integration_;
   input.axle_track_m = params_.axle_track_m;
+  const double drift = params_.self_calibration.wheel_slip_drift_std_per_sqrt_m;
+  input.wheel_slip_drift_per_m = drift * drift;
   return input;
 }
 

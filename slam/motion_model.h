@@ -18,7 +18,8 @@ struct MotionInput {
   Eigen::Matrix2d covariance = Eigen::Matrix2d::Zero();
   /// Variance of a sideways slip of R over the step, m^2: a displacement
   /// across the mid-arc heading th + dth / 2 that Eq. (6) does not model,
-  /// independent of `increment` (EkfParams::lateral_slip_std_m_per_rad).
+  /// independent of `increment` (EkfParams::lateral_slip_std_m_per_rad and
+  /// lateral_slip_std_m_per_sqrt_m).
   double lateral_variance_m2 = 0.0;
   /// Skid to the outside of the turn, per metre and radian of `increment`:
   /// R moves by -skid d dth across the mid-arc heading (EkfParams::lateral_skid_s
@@ -26,6 +27,10 @@ struct MotionInput {
   double skid_per_m_rad = 0.0;
   /// How Eq. (6) is integrated over the step (EkfParams::motion_integration).
   MotionIntegration integration = MotionIntegration::kExact;
+  /// Variance of each wheel's slip fraction per metre it rolls, with
+  /// self-calibration (SelfCalibrationParams::wheel_slip_drift_std_per_sqrt_m
+  /// squared); 0: the odometry's errors are constant.
+  double wheel_slip_drift_per_m = 0.0;
   /// The wheels' track, metres, for self-calibration's term k B^2 / 4 dth
   /// (EkfParams::axle_track_m); unused without it.
   double axle_track_m = 0.0;

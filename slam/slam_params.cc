@@ -66,6 +66,7 @@ std::vector<ParamProblem> SelfCalibrationParams::Validate() const {
   check.InRange("heading_per_m_std_rad", heading_per_m_std_rad, 0.0, 1.0);
   check.InRange("range_bias_std_m", range_bias_std_m, 0.0, 1.0);
   check.InRange("range_scale_std", range_scale_std, 0.0, 0.5);
+  check.InRange("wheel_slip_drift_std_per_sqrt_m", wheel_slip_drift_std_per_sqrt_m, 0.0, 0.5);
   return check.problems();
 }
 
@@ -83,6 +84,7 @@ std::vector<ParamProblem> EkfParams::Validate() const {
   check.Merge("odometry_noise", odometry_noise.Validate());
   check.Merge("self_calibration", self_calibration.Validate());
   check.NonNegative("lateral_slip_std_m_per_rad", lateral_slip_std_m_per_rad);
+  check.NonNegative("lateral_slip_std_m_per_sqrt_m", lateral_slip_std_m_per_sqrt_m);
   check.NonNegative("lateral_skid_s", lateral_skid_s);
   check.OneOf("jacobians", jacobians,
               std::vector<std::string>(std::begin(kJacobianPointNames),

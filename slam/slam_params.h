@@ -165,6 +165,15 @@ struct SelfCalibrationParams {
   double heading_per_m_std_rad = 0.0;
   double range_bias_std_m = 0.0;
   double range_scale_std = 0.0;
+  /// Drift of each wheel's slip fraction, one standard deviation per
+  /// sqrt(metre) that wheel rolls: the odometry's errors (q_d, q_th, k)
+  /// are a random walk, not constants, so that slip correlated over metres
+  /// (wet patches, tyre wear, a wheel's load) is tracked. A wheel's travel
+  /// delta adds s^2 delta of variance to its slip; q_d and q_th move with the
+  /// mean of the wheels' slips, k with their difference over the track B:
+  /// Q_cal = s^2 (delta_l + delta_r) [[1/4, 1/4, 0], [1/4, 1/4, 0], [0, 0, 1/B^2]]
+  /// on the entries that are estimated. 0: constant errors.
+  double wheel_slip_drift_std_per_sqrt_m = 0.0;
   /// True when any entry is estimated.
   bool Enabled() const {
     return distance_scale_std > 0.0 || heading_scale_std > 0.0 || heading_per_m_std_rad > 0.0 ||
@@ -178,6 +187,7 @@ struct SelfCalibrationParams {
     a->Visit(MJSLAM_NVP(heading_per_m_std_rad));
     a->Visit(MJSLAM_NVP(range_bias_std_m));
     a->Visit(MJSLAM_NVP(range_scale_std));
+    a->Visit(MJSLAM_NVP(wheel_slip_drift_std_per_sqrt_m));
   }
   /// Every out-of-range field, keys relative to this struct.
   std::vector<ParamProblem> Validate() const;
@@ -214,6 +224,11 @@ struct EkfParams {
   /// prediction adds (k |dth|)^2 of variance across the mid-arc heading
   /// (docs/method.md, departure 10).
   double lateral_slip_std_m_per_rad = 0.005;
+  /// Lateral slip of R per metre rolled, one standard deviation after 1 m,
+  /// metres per sqrt(metre), with either input: a sideways random walk over
+  /// the distance driven. The prediction adds k^2 |d| of variance across the
+  /// mid-arc heading, in addition to the term per radian above.
+  double lateral_slip_std_m_per_sqrt_m = 0.0;
   /// Sideways skid of the axle centre in turns, seconds: Eq. (6) has no
   /// sideways motion, but tyres skid to the outside of a turn at a speed
   /// proportional to the centripetal acceleration, c v w. The prediction
@@ -315,6 +330,7 @@ struct EkfParams {
     a->Visit(MJSLAM_NVP(odometry_noise));
     a->Visit(MJSLAM_NVP(self_calibration));
     a->Visit(MJSLAM_NVP(lateral_slip_std_m_per_rad));
+    a->Visit(MJSLAM_NVP(lateral_slip_std_m_per_sqrt_m));
     a->Visit(MJSLAM_NVP(lateral_skid_s));
     a->Visit(MJSLAM_NVP(jacobians));
     a->Visit(MJSLAM_NVP(initial_position_std_m));

@@ -27,7 +27,7 @@ constexpr double kMinCornerRange = 1e-9;
 SlamState::SlamState(const Eigen::Vector3d& pose_WR, const Eigen::Matrix3d& pose_covariance,
                      const Pose2& X_RS, JacobianPoint jacobians,
                      const Eigen::VectorXd& calibration_std)
-    : X_RS_(X_RS), x_(pose_WR), jacobians_(jacobians) {
+    : X_RS_(X_RS), x_(pose_WR), jacobians_(jacobians), calibration_std_(calibration_std) {
   MJSLAM_CHECK(calibration_std.size() == 0 || calibration_std.size() == kCalibrationSize);
   x_.z() = WrapAngleFast(x_.z());
   vehicle_size_ = 3 + static_cast<int>(calibration_std.size());
@@ -153,6 +153,29 @@ void SlamState::PredictCalibrated(const MotionInput& raw, double a_m) {
   P_.block(3, 0, n - 3, 3) = T.bottomRows(n - 3);
   P_.block(0, 3, 3, n - 3) = T.bottomRows(n - 3).transpose();
   P_.topLeftCorner<3, 3>() = 0.5 * (P_pp_new + P_pp_new.transpose());
+  AddCalibrationDrift(raw);
+}
+
+void SlamState::AddCalibrationDrift(const MotionInput& raw) {
+  if (raw.wheel_slip_drift_per_m <= 0.0) return;
+  // The wheels' travel, and the random walk of the slips' mean (q_d, q_th)
+  // and difference over the track (k), on the entries that are estimated.
+  const double half_track = 0.5 * raw.axle_track_m;
+  const double d = raw.increment.x();
+  const double dth = raw.increment.y();
+  const double travel = std::abs(d - half_track * dth) + std::abs(d + half_track * dth);
+  const double variance = raw.wheel_slip_drift_per_m * travel;
+  const bool q_d = calibration_std_[0] > 0.0;
+  const bool q_th = calibration_std_[1] > 0.0;
+  if (q_d) P_(kDistanceScale, kDistanceScale) += 0.25 * variance;
+  if (q_th) P_(kHeadingScale, kHeadingScale) += 0.25 * variance;
+  if (q_d && q_th) {
+    P_(kDistanceScale, kHeadingScale) += 0.25 * variance;
+    P_(kHeadingScale, kDistanceScale) += 0.25 * variance;
+  }
+  if (calibration_std_[2] > 0.0) {
+    P_(kHeadingPerMetre, kHeadingPerMetre) += variance / (raw.axle_track_m * raw.axle_track_m);
+  }
 }
 
 bool SlamState::PredictWithJacobians(int k, Eigen::Vector2d* h,

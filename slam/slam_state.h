@@ -221,6 +221,9 @@ class SlamState {
   bool PredictWithJacobians(int k, Eigen::Vector2d* h, Eigen::Matrix<double, 2, 3>* H_pose,
                             Eigen::Matrix2d* H_feature) const;
 
+  // The random walk of the odometry's errors (MotionInput::wheel_slip_drift_per_m).
+  void AddCalibrationDrift(const MotionInput& raw);
+
   Pose2 X_RS_;
   // 3, or 3 + kCalibrationSize with self-calibration.
   int vehicle_size_ = 3;
@@ -229,6 +232,9 @@ class SlamState {
   // Capacity x capacity buffer; P is its top-left n_ x n_ block.
   Eigen::MatrixXd P_;
   JacobianPoint jacobians_;
+  // The prior standard deviations of the self-calibration entries (empty
+  // without it): an entry with 0 is not estimated.
+  Eigen::VectorXd calibration_std_;
   // With kFirstEstimates: the pose's predicted estimate and the features'
   // first estimates (size n); empty otherwise.
   Eigen::VectorXd x_first_;
