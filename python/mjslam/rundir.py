@@ -572,10 +572,14 @@ class Run:
 
     def errors(self, name):
         """(N, 3) estimate - true pose of filter `name` per step (heading wrapped, wrap_angle),
-        against the true pose of the same step. (mjslam evaluate compares a step the filter
-        skipped with the true pose of its last processed step; on processed steps the two are
-        the same.)"""
-        error = self.poses(name) - self.poses("true")
+        as mjslam evaluate compares them (app/evaluate.cc): on a step the filter skipped
+        (slam.timing realtime) it holds the estimate of its last processed step, compared with
+        that step's true pose; on every other step, with the step's own."""
+        processed = self.processed(name)
+        processed[0] = True
+        steps = np.arange(len(processed))
+        held = np.maximum.accumulate(np.where(processed, steps, 0))
+        error = self.poses(name) - self.poses("true")[held]
         error[:, 2] = wrap_angle(error[:, 2])
         return error
 
@@ -584,10 +588,10 @@ class Run:
         return self.trajectory[name + "_nees"]
 
     def processed(self, name):
-        """Whether filter `name` processed each step's record (all True for a run without the
-        f_processed column)."""
+        """Whether filter `name` processed each step's record: f_processed not 0 (all True for
+        a run without the column)."""
         column = self.trajectory.get(name + "_processed")
-        return np.ones(len(self.trajectory), bool) if column is None else column == 1.0
+        return np.ones(len(self.trajectory), bool) if column is None else column != 0.0
 
 
 class Sweep:
