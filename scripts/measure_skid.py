@@ -10,14 +10,18 @@ along and across its mid-arc heading, while the heading changes by dth. A
 unicycle has lat = 0; a skidding one lat = -c v w dt with v = fwd / dt and
 w = dth / dt, the true speeds. Prints c by least squares over all steps,
 the skid before and after removing c v w dt (rms, mm per step), and what is
-left per radian turned, which lateral_slip_std_m_per_rad must cover.
+left per radian turned, which lateral_slip_std_m_per_rad must cover. Reads
+the runs with python/mjslam (Debian's Python 3 with numpy).
 """
 import argparse
-import csv
 import math
 import os
 import sys
 
+# python/mjslam, the reader of run directories, found from this file: no build, no PYTHONPATH.
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
+                                "python"))
+import mjslam  # noqa: E402
 
 
 def axle_motion(x0, y0, th0, x1, y1, th1, offset):
@@ -31,16 +35,13 @@ def axle_motion(x0, y0, th0, x1, y1, th1, offset):
     return dx * math.cos(mid) + dy * math.sin(mid), dth, -dx * math.sin(mid) + dy * math.cos(mid)
 
 
-def steps(path, offset):
-    """(fwd, lat, dth, dt) of the axle centre for each step of a trajectory."""
-    with open(path) as f:
-        rows = list(csv.DictReader(f))
-    for r0, r1 in zip(rows, rows[1:]):
-        dt = float(r1["t"]) - float(r0["t"])
-        if dt <= 0.0:
-            continue
-        pose0 = [float(r0[k]) for k in ("true_x", "true_y", "true_th")]
-        pose1 = [float(r1[k]) for k in ("true_x", "true_y", "true_th")]
+def steps(run, offset):
+    """(fwd, lat, dth, dt) of the axle centre for each step of a run's trajectory (its times
+    increase: the reader checks them)."""
+    times = run.trajectory["t"].tolist()
+    poses = run.poses("true").tolist()
+    for t0, t1, pose0, pose1 in zip(times, times[1:], poses, poses[1:]):
+        dt = t1 - t0
         fwd, dth, lat = axle_motion(*pose0, *pose1, offset)
         yield fwd, lat, dth, dt
 
@@ -54,11 +55,11 @@ def main():
 
     data = []
     for run in args.runs:
-        path = os.path.join(run, "trajectory.csv")
-        if not os.path.isfile(path):
-            print(f"{path}: no such file", file=sys.stderr)
+        run = mjslam.read_run(run)
+        if not run.has(mjslam.TRAJECTORY_FILE):
+            print(f"{run.file(mjslam.TRAJECTORY_FILE)}: no such file", file=sys.stderr)
             return 2
-        data.extend(steps(path, args.offset))
+        data.extend(steps(run, args.offset))
     if not data:
         print("no steps", file=sys.stderr)
         return 2
