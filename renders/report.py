@@ -4,22 +4,25 @@
     python3 renders/report.py run RUN_DIR
     python3 renders/report.py sweep SWEEP_DIR
 
-Called by `mjslam render` (and `mjslam run` when render.enabled). Reads the
-files described in docs/run_directory.md; the columns the
+Called by `mjslam render` (and `mjslam run` when render.enabled), with
+/usr/bin/python3. Reads the files described in docs/run_directory.md with
+python/mjslam; the columns the
 closed-loop integration adds (explored, f_period, f_open_loop, f_nees) and the files
 summary.json, explorer.csv, nees.csv, divergence.csv are optional. Every
 output is written to a temporary name and renamed. Exits 1 with a message
 naming the file on bad input.
 """
-import csv
 import html
-import json
 import math
 import os
 import signal
 import sys
 
-import matplotlib
+# python/mjslam, the reader of run directories, found from this file: no build, no PYTHONPATH.
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
+                                "python"))
+import mjslam  # noqa: E402
+import matplotlib  # noqa: E402
 
 matplotlib.use("Agg")  # no display
 import matplotlib.pyplot as plt  # noqa: E402
@@ -27,27 +30,8 @@ import matplotlib.ticker  # noqa: E402
 
 # The renders' colours (renders/scene_renderer.h, namespace colors).
 COLORS = {"truth": "#0d0d0d", "classical": "#ff8000", "selective": "#0066ff"}
-FILTERS = ("classical", "selective")
+FILTERS = mjslam.FILTER_NAMES
 DPI = 100
-
-
-def read_csv(path):
-    """Columns of a CSV file as lists of floats (text kept as text)."""
-    with open(path, newline="") as f:
-        rows = list(csv.reader(f))
-    if not rows:
-        raise ValueError(f"{path}: empty file")
-    header, data = rows[0], rows[1:]
-    columns = {name: [] for name in header}
-    for line, row in enumerate(data, start=2):
-        if len(row) != len(header):
-            raise ValueError(f"{path}:{line}: expected {len(header)} fields (got {len(row)})")
-        for name, field in zip(header, row):
-            try:
-                columns[name].append(float(field) if field != "" else math.nan)
-            except ValueError:
-                columns[name].append(field)
-    return columns
 
 
 def remove_quietly(path):
@@ -272,12 +256,11 @@ def flatten(prefix, value, out):
 
 
 def summary_rows(directory):
-    for name in ("summary.json", "manifest.json"):
+    for name in (mjslam.SUMMARY_FILE, mjslam.MANIFEST_FILE):
         path = os.path.join(directory, name)
         if os.path.exists(path):
-            with open(path) as f:
-                data = json.load(f)
-            if name == "manifest.json":
+            data = mjslam.read_json_object(path)
+            if name == mjslam.MANIFEST_FILE:
                 keep = ("status", "seed", "world_file", "sim_time_s", "steps", "mjslam_version",
                         "git_commit", "mujoco_version", "start_time", "end_time", "error")
                 data = {k: data[k] for k in keep if k in data}
@@ -298,11 +281,7 @@ def data_files(directory):
 
 
 def run_report(directory):
-    traj_path = os.path.join(directory, "trajectory.csv")
-    traj = read_csv(traj_path)
-    for column in ("t", "true_x", "true_y", "true_th"):
-        if column not in traj:
-            raise ValueError(f"{traj_path}: missing column '{column}'")
+    traj = mjslam.read_run(directory).trajectory
     plots = [("plot_pose_error.png", "Pose error and ±2σ bounds (paper Fig. 3c-e)", plot_pose_errors),
              ("plot_processing_time.png", "Accumulated processing time (Fig. 4c)", plot_processing)]
     if all(f"{f}_open_loop" in traj for f in FILTERS):
@@ -331,16 +310,15 @@ def sweep_report(directory):
     source, rows = summary_rows(directory)
     if rows:
         body.append(f"<h2>Summary ({source})</h2>" + table(rows))
-    nees_path = os.path.join(directory, "nees.csv")
+    sweep = mjslam.read_sweep(directory)
     body.append("<h2>Plots</h2>")
-    if os.path.exists(nees_path):
-        plot_nees(read_csv(nees_path), os.path.join(directory, "plot_nees.png"))
+    if sweep.has(mjslam.NEES_FILE):
+        plot_nees(sweep.nees, os.path.join(directory, "plot_nees.png"))
         body.append('<h3>Average NEES and 95 % bounds (not a figure of the paper)</h3><img src="plot_nees.png" alt="average NEES">')
-    div_path = os.path.join(directory, "divergence.csv")
-    if os.path.exists(div_path):
-        plot_divergence(read_csv(div_path), os.path.join(directory, "plot_divergence.png"))
+    if sweep.divergence is not None:
+        plot_divergence(sweep.divergence, os.path.join(directory, "plot_divergence.png"))
         body.append('<h3>Divergence against #E (paper Figs. 6 and 7 together)</h3><img src="plot_divergence.png" alt="divergence">')
-    runs_dir = os.path.join(directory, "runs")
+    runs_dir = os.path.join(directory, mjslam.SWEEP_RUNS_FOLDER)
     if os.path.isdir(runs_dir):
         items = []
         for name in sorted(os.listdir(runs_dir)):

@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """The true heading increments of a run against its commands, normalised by
 the filters' command-noise model, grouped by control periods since the last
 change of the turn command (docs/results.md, "The maze map loss").
@@ -7,12 +7,18 @@ change of the turn command (docs/results.md, "The maze map loss").
 
 The defaults are slam.ekf.command_noise's (0.03 rad/s, 0.1, 0.5). Reads
 RUN_DIR/trajectory.csv (t, true_th, cmd_w; the command of row i is held from
-t_i to t_(i+1)). Prints, per period since the change, the steps and those
-beyond 3 and 4 sigma, then each step beyond 3 sigma. Python 3 standard library.
+t_i to t_(i+1)) with python/mjslam. Prints, per period since the change, the
+steps and those beyond 3 and 4 sigma, then each step beyond 3 sigma. Debian's
+Python 3 with numpy (/usr/bin/python3).
 """
-import csv
 import math
+import os
 import sys
+
+# python/mjslam, the reader of run directories, found from this file: no build, no PYTHONPATH.
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
+                                "python"))
+import mjslam  # noqa: E402
 
 
 def main():
@@ -20,8 +26,8 @@ def main():
         sys.exit(__doc__)
     w_std, w_fraction, change_fraction = (0.03, 0.1, 0.5) if len(sys.argv) == 2 else map(
         float, sys.argv[2:5])
-    with open(sys.argv[1] + "/trajectory.csv") as f:
-        rows = [(float(r["t"]), float(r["true_th"]), float(r["cmd_w"])) for r in csv.DictReader(f)]
+    trajectory = mjslam.read_run(sys.argv[1]).trajectory
+    rows = list(zip(*(trajectory[c].tolist() for c in ("t", "true_th", "cmd_w"))))
     groups = {}
     outliers = []
     since = 99

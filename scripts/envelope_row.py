@@ -1,31 +1,37 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """One row of scripts/envelope_table.sh: a sweep directory's pooled figures.
 
-Usage: envelope_row.py SWEEP_DIR NAME. Reads SWEEP_DIR/summary.json and each
-run's summary.json (runs/run_*/summary.json) for the worst run's 2-sigma
-fraction (the smallest of its x, y, th). Python 3 standard library.
+Usage: envelope_row.py SWEEP_DIR NAME. Reads, with python/mjslam, SWEEP_DIR/summary.json
+and each run's summary.json (runs/run_*/summary.json) for the worst run's 2-sigma
+fraction (the smallest of its x, y, th). Debian's Python 3 with numpy (/usr/bin/python3).
 """
-import glob
-import json
+import os
 import sys
+
+# python/mjslam, the reader of run directories, found from this file: no build, no PYTHONPATH.
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
+                                "python"))
+import mjslam  # noqa: E402
 
 
 def main():
     sweep_dir, name = sys.argv[1], sys.argv[2]
+    sweep = mjslam.read_sweep(sweep_dir)
     try:
-        summary = json.load(open(sweep_dir + "/summary.json"))
+        summary = sweep.summary
     except (OSError, ValueError) as error:
         print(f"| {name} | no summary ({error}) |")
         return
+    runs = [r for r in sweep.runs if r.has(mjslam.SUMMARY_FILE)]
     cells = [name]
-    for f in ("classical", "selective"):
+    for f in mjslam.FILTER_NAMES:
         filt = summary["filters"][f]
         pooled = filt.get("inside_2sigma_pooled") or {}
         worst = 1.0
-        for path in glob.glob(sweep_dir + "/runs/run_*/summary.json"):
-            run = json.load(open(path))["filters"][f].get("inside_2sigma") or {}
-            if run:
-                worst = min(worst, min(run[c] for c in ("x", "y", "th")))
+        for run in runs:
+            inside = run.summary["filters"][f].get("inside_2sigma") or {}
+            if inside:
+                worst = min(worst, min(inside[c] for c in ("x", "y", "th")))
         cells.append("%.3f / %.3f, %.2f" % (filt["fraction_inside"], filt["fraction_above"],
                                             filt["mean_anees"]))
         cells.append("%.3f / %.3f / %.3f" % (pooled.get("x", 0), pooled.get("y", 0),

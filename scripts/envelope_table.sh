@@ -46,6 +46,6 @@ for entry in "${conditions[@]}"; do
   dir="$out/cond_$i"
   build/mjslam sweep --runs "$runs" --config "$config" --set run.seed="$seed" \
     --set render.enabled=false "${sets[@]}" --out "$dir" > "$dir.log" 2>&1 || true
-  python3 scripts/envelope_row.py "$dir" "$name"
+  /usr/bin/python3 scripts/envelope_row.py "$dir" "$name"
   i=$((i + 1))
 done

@@ -13,32 +13,38 @@ the config's 300 s).
 
 Runs `build/mjslam sweep` once per world (seeds run.seed + 0 .. N-1, into
 DIR/<world>/runs/; each --set is passed on to the sweep), then reads each
-run's summary.json and trajectory.csv. A world passes when no run has a
+run's summary.json and trajectory.csv with python/mjslam (Debian's Python 3
+with numpy). A world passes when no run has a
 collision, every run has seen at least --min-explored (default 0.95) of the
 reachable free area, and
 both filters keep the pose error inside 2 sigma for at least 90 % of the steps
-per component, the steps of its runs pooled. Exit status 0 when every world
+per component, the steps of its runs pooled (each run's fractions are its
+summary.json's inside_2sigma, of mjslam evaluate). Exit status 0 when every world
 passes, 1 otherwise.
 
 With --per-run, a second table gives every run: its fraction of steps inside
 2 sigma and the rms of error / sigma (1 for a consistent filter), per filter
-and component, over the steps with a nonzero sigma.
+and component, over the steps with a nonzero sigma. Errors as mjslam evaluate
+takes them (mjslam.Run.errors): with slam.timing realtime, a step the filter
+skipped compares its held estimate with the truth of its last processed step.
 
 The column "5-seed groups" applies the 2-sigma target to each group of 5
 consecutive seeds (seeds 1-5, 6-10, ...) on its own and says how many
 groups meet it: with --runs 40 it shows how often 5 seeds are enough.
 """
 import argparse
-import csv
-import json
 import math
 import os
 import subprocess
 import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+# python/mjslam, the reader of run directories, found from this file: no build, no PYTHONPATH.
+sys.path.insert(0, os.path.join(ROOT, "python"))
+import mjslam  # noqa: E402
+
 WORLDS = ["room", "corridor_loop", "office", "pillars"]
-FILTERS = ["classical", "selective"]
+FILTERS = list(mjslam.FILTER_NAMES)
 
 
 def world_file(world):
@@ -65,27 +71,20 @@ def sweep(world, out, runs, jobs, overrides, duration):
     subprocess.run(command, check=True, stdout=sys.stderr)
 
 
-def inside_counts(path):
-    """Steps, steps inside 2 sigma per filter and component, and the
+def inside_counts(run):
+    """Steps, steps inside 2 sigma per filter and component (summary.json's
+    inside_2sigma, the fraction of mjslam evaluate), and the
     [sum of (error / sigma)^2, count] per filter and component, of a run."""
-    counts = {f: [0, 0, 0] for f in FILTERS}
+    steps = len(run.trajectory)
+    counts = {f: [round(run.summary["filters"][f]["inside_2sigma"][c] * steps)
+                  for c in ("x", "y", "th")] for f in FILTERS}
     squares = {f: [[0.0, 0] for _ in range(3)] for f in FILTERS}
-    steps = 0
-    with open(path) as f:
-        for row in csv.DictReader(f):
-            steps += 1
-            for name in FILTERS:
-                error = [float(row[f"{name}_x"]) - float(row["true_x"]),
-                         float(row[f"{name}_y"]) - float(row["true_y"]),
-                         math.remainder(float(row[f"{name}_th"]) - float(row["true_th"]), 2 * math.pi)]
-                variance = [float(row[f"{name}_p{c}"]) for c in ("xx", "yy", "thth")]
-                for k in range(3):
-                    # The known start has zero error and zero variance: inside.
-                    if abs(error[k]) <= 2.0 * math.sqrt(max(variance[k], 0.0)) + 1e-12:
-                        counts[name][k] += 1
-                    if variance[k] > 0.0:
-                        squares[name][k][0] += error[k] * error[k] / variance[k]
-                        squares[name][k][1] += 1
+    for name in FILTERS:
+        for error, variance in zip(run.errors(name).tolist(), run.variances(name).tolist()):
+            for k in range(3):
+                if variance[k] > 0.0:
+                    squares[name][k][0] += error[k] * error[k] / variance[k]
+                    squares[name][k][1] += 1
     return steps, counts, squares
 
 
@@ -128,18 +127,14 @@ def main():
         label = world_label(world)
         out = os.path.join(args.out, label)
         sweep(world, out, args.runs, args.jobs, args.set, args.duration)
-        runs_dir = os.path.join(out, "runs")
         summaries = []
         runs = []  # (steps, counts) per run, in seed order
-        for name in sorted(os.listdir(runs_dir)):
-            path = os.path.join(runs_dir, name, "summary.json")
-            if os.path.isfile(path):
-                with open(path) as f:
-                    summaries.append(json.load(f))
-                runs.append(inside_counts(os.path.join(runs_dir, name, "trajectory.csv")))
+        for run in mjslam.read_sweep(out).runs:
+            if run.has(mjslam.SUMMARY_FILE):
+                summaries.append(run.summary)
+                runs.append(inside_counts(run))
                 steps, counts, squares = runs[-1]
-                with open(os.path.join(runs_dir, name, "manifest.json")) as f:
-                    seed = json.load(f)["seed"]
+                seed = run.manifest["seed"]
                 cells = [f"`{label}`", str(seed), str(steps)]
                 cells += [", ".join(f"{c / steps:.2f}" for c in counts[f]) for f in FILTERS]
                 cells += [", ".join(f"{math.sqrt(q / max(n, 1)):.2f}" for q, n in squares[f])

@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """How sharp the map of an imported run is with each trajectory (docs/real_data.md).
 
 Places every scan's returns (ranges below the maximum) with the odometry's,
@@ -10,19 +10,24 @@ cells). Prints also each path's length and the distance and heading between
 its first and last pose (whether the path closes) and, with a reference, the
 mean and largest distance of each pose from the reference's at the scan.
 
-Usage: scripts/map_sharpness.py RUN_DIR [CELL]   (Python 3, standard library only)
+Usage: scripts/map_sharpness.py RUN_DIR [CELL]   (reads the run with python/mjslam: Debian's
+Python 3 with numpy, /usr/bin/python3)
 """
-import csv
-import json
 import math
+import os
 import sys
+
+# python/mjslam, the reader of run directories, found from this file: no build, no PYTHONPATH.
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
+                                "python"))
+import mjslam  # noqa: E402
 
 
 def main():
-    run = sys.argv[1]
+    path = sys.argv[1]
     cell = float(sys.argv[2]) if len(sys.argv) > 2 else 0.05
-    with open(f"{run}/manifest.json") as f:
-        manifest = json.load(f)
+    run = mjslam.read_run(path)
+    manifest = run.manifest
     mount = manifest["laser_mount"]  # the laser in frame R
     angle_min = math.radians(manifest["angle_min_deg"])
     step = math.radians(manifest["angle_step_deg"])
@@ -31,44 +36,37 @@ def main():
     # The fan of config.laser is centred on the mount's x axis: beam b at
     # -fov/2 + b step in S (the mount's turn holds the log's own offset).
     half_fov = 0.5 * (n - 1) * step
-    poses = {}
-    with open(f"{run}/trajectory.csv") as f:
-        for row in csv.DictReader(f):
-            poses[row["t"]] = row
+    # Each source's poses, by the row of trajectory.csv (the step at a scan's time).
+    row_at = {t: i for i, t in enumerate(run.trajectory["t"].tolist())}
     sources = ["odom", "classical", "selective"]
-    try:  # the log's own estimate, at the scans, in frame R
-        with open(f"{run}/reference.csv") as f:
-            for row in csv.DictReader(f):
-                poses[row["t"]].update({"reference_x": row["x"], "reference_y": row["y"],
-                                        "reference_th": row["th"]})
+    poses = {s: run.poses(s).tolist() for s in sources}
+    reference = run.reference
+    if reference is not None:  # the log's own estimate, at the scans, in frame R
+        poses["reference"] = {row_at[t]: pose for t, pose in zip(
+            reference["t"].tolist(),
+            zip(reference["x"].tolist(), reference["y"].tolist(), reference["th"].tolist()))}
         sources.append("reference")
-    except FileNotFoundError:
-        pass
     cells = {s: set() for s in sources}
     paths = {s: [] for s in sources}
     points = 0
-    with open(f"{run}/scans.csv") as f:
-        reader = csv.reader(f)
-        header = next(reader)
-        first_range = header.index("r0")
-        for row in reader:
-            pose_row = poses[row[0]]
-            ranges = [float(v) for v in row[first_range:first_range + n]]
-            for s in sources:
-                x, y, th = (float(pose_row[f"{s}_{k}"]) for k in ("x", "y", "th"))
-                paths[s].append((x, y, th))
-                c, si = math.cos(th), math.sin(th)
-                sx = x + c * mount["x"] - si * mount["y"]
-                sy = y + si * mount["x"] + c * mount["y"]
-                sth = th + mount["th"]
-                for b, r in enumerate(ranges):
-                    if not r < max_range:
-                        continue
-                    a = sth - half_fov + b * step
-                    cells[s].add((math.floor((sx + r * math.cos(a)) / cell),
-                                  math.floor((sy + r * math.sin(a)) / cell)))
-            points += sum(1 for r in ranges if r < max_range)
-    print(f"{run}: {points} returns of {len(paths['odom'])} scans on {cell:.2f} m cells")
+    scans = run.scans
+    for t, ranges in zip(scans.t.tolist(), scans.ranges[:, :n].tolist()):
+        row = row_at[t]
+        for s in sources:
+            x, y, th = poses[s][row]
+            paths[s].append((x, y, th))
+            c, si = math.cos(th), math.sin(th)
+            sx = x + c * mount["x"] - si * mount["y"]
+            sy = y + si * mount["x"] + c * mount["y"]
+            sth = th + mount["th"]
+            for b, r in enumerate(ranges):
+                if not r < max_range:
+                    continue
+                a = sth - half_fov + b * step
+                cells[s].add((math.floor((sx + r * math.cos(a)) / cell),
+                              math.floor((sy + r * math.sin(a)) / cell)))
+        points += sum(1 for r in ranges if r < max_range)
+    print(f"{path}: {points} returns of {len(paths['odom'])} scans on {cell:.2f} m cells")
     print("trajectory   cells    returns/cell   path m   first-to-last m   heading deg"
           "   from the reference m (mean / max)")
     for s in sources:

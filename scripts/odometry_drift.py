@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """Wheel odometry's drift per metre and per radian, simulated or real.
 
 Usage: odometry_drift.py RUN_DIR [RUN_DIR ...]
@@ -10,12 +10,16 @@ log's own pose estimate (reference.csv, at the scans). Windows start every
 0.5 m (and 0.5 rad) of the reference's path. Prints per run directory the RMS
 over windows of the translation error (m per m driven) and of the heading
 error (deg per m driven and deg per rad turned), and the number of windows.
-Python 3 standard library.
+Reads the runs with python/mjslam (Debian's Python 3 with numpy, /usr/bin/python3).
 """
-import csv
 import math
 import os
 import sys
+
+# python/mjslam, the reader of run directories, found from this file: no build, no PYTHONPATH.
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
+                                "python"))
+import mjslam  # noqa: E402
 
 
 def wrap(a):
@@ -31,21 +35,18 @@ def relative(a, b):
 
 def read_pairs(run_dir):
     """(reference pose, odometry pose) pairs in time order."""
-    rows = list(csv.DictReader(open(os.path.join(run_dir, "trajectory.csv"))))
-    reference_path = os.path.join(run_dir, "reference.csv")
-    pairs = []
-    if rows and rows[0].get("true_x", "") not in ("", "nan"):
-        for r in rows:
-            pairs.append(((float(r["true_x"]), float(r["true_y"]), float(r["true_th"])),
-                          (float(r["odom_x"]), float(r["odom_y"]), float(r["odom_th"]))))
-    elif os.path.exists(reference_path):
-        odom = {r["t"]: r for r in rows}
-        for r in csv.DictReader(open(reference_path)):
-            o = odom.get(r["t"])
-            if o is None:
-                continue
-            pairs.append(((float(r["x"]), float(r["y"]), float(r["th"])),
-                          (float(o["odom_x"]), float(o["odom_y"]), float(o["odom_th"]))))
+    run = mjslam.read_run(run_dir)
+    truth = [tuple(p) for p in run.poses("true").tolist()]
+    odometry = [tuple(p) for p in run.poses("odom").tolist()]
+    if not math.isnan(truth[0][0]):
+        pairs = list(zip(truth, odometry))
+    elif run.reference is not None:
+        # The log's poses at the scans, each with the odometry of the step at its time.
+        odometry_at = dict(zip(run.trajectory["t"].tolist(), odometry))
+        reference = run.reference
+        poses = zip(reference["x"].tolist(), reference["y"].tolist(), reference["th"].tolist())
+        pairs = [(pose, odometry_at[t]) for t, pose in zip(reference["t"].tolist(), poses)
+                 if t in odometry_at]
     else:
         sys.exit(f"odometry_drift.py: {run_dir}: no true pose and no reference.csv")
     return pairs

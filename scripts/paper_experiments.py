@@ -46,15 +46,17 @@ import argparse
 import json
 import math
 import os
-import re
 import subprocess
 import sys
 import time
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+# python/mjslam, the reader of run directories, found from this file: no build, no PYTHONPATH.
+sys.path.insert(0, os.path.join(ROOT, "python"))
+sys.path.insert(1, os.path.dirname(os.path.abspath(__file__)))
+import mjslam  # noqa: E402
 import paper_figures as figs  # noqa: E402
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 FILTERS = figs.FILTERS
 PAIRS = ("classical_selective", "selective_classical", "classical_truth", "selective_truth")
 DEFAULT_POINTS = (100, 200, 500, 1000, 2000, 5000, 10000, 20000, 50000, 100000)
@@ -80,11 +82,6 @@ def run_command(command, log_path=None):
     return time.monotonic() - start
 
 
-def read_json(path):
-    with open(path) as f:
-        return json.load(f)
-
-
 def finite(values):
     return [v for v in values if v is not None and not (isinstance(v, float) and math.isnan(v))]
 
@@ -104,49 +101,35 @@ def fmt(x, digits=3):
     return ("%%.%dg" % digits) % x
 
 
-def config_value(run_dir, key):
-    """A scalar of the run's resolved config.yaml, by its last key name (unique in the file)."""
-    with open(os.path.join(run_dir, "config.yaml")) as f:
-        found = re.findall(r"^\s*%s:\s*([^\s#]+)" % re.escape(key), f.read(), re.M)
-    if len(found) != 1:
-        raise SystemExit("%s/config.yaml: expected one '%s' (found %d)" % (run_dir, key, len(found)))
-    return found[0]
-
-
-def timing_of(run_dir):
-    """(cost, dt): the cost model (base, k, steps per scan) and the control period of a run."""
-    dt = 1.0 / float(config_value(run_dir, "control_rate_hz"))
-    steps_per_scan = max(1, int(round(float(config_value(run_dir, "control_rate_hz")) /
-                                      float(config_value(run_dir, "rate_hz")))))
-    cost = (float(config_value(run_dir, "model_base_s")),
-            float(config_value(run_dir, "model_s_per_update_per_n2")), steps_per_scan)
+def timing_of(run):
+    """(cost, dt): the cost model (base, k, steps per scan) and the control period of a run
+    (mjslam.Run), from its resolved config.yaml."""
+    control_rate_hz = float(run.setting("run.control_rate_hz"))
+    dt = 1.0 / control_rate_hz
+    steps_per_scan = max(1, int(round(control_rate_hz / float(run.setting("laser.rate_hz")))))
+    cost = (float(run.setting("control.model_base_s")),
+            float(run.setting("control.model_s_per_update_per_n2")), steps_per_scan)
     return cost, dt
-
-
-def run_dirs_of(sweep_dir):
-    root = os.path.join(sweep_dir, "runs")
-    return sorted(os.path.join(root, d) for d in os.listdir(root)
-                  if os.path.isdir(os.path.join(root, d)))
 
 
 # ---------------------------------------------------------------------------------------------
 # Experiments.
 
-def sweep(mjslam, config, world, runs, jobs, out, duration, extra=()):
+def sweep(program, config, world, runs, jobs, out, duration, extra=()):
     """One evaluated sweep into `out`, unless its summary.json exists. Returns its summary."""
-    if not os.path.exists(os.path.join(out, "summary.json")):
-        command = [mjslam, "sweep", "--config", config, "--runs", str(runs), "--jobs", str(jobs),
+    if not os.path.exists(os.path.join(out, mjslam.SUMMARY_FILE)):
+        command = [program, "sweep", "--config", config, "--runs", str(runs), "--jobs", str(jobs),
                    "--out", out, "--set", "run.world=" + world, "--set", "render.enabled=false",
                    "--divergence-points", "20000", "--quiet"] + list(extra)
         if duration is not None:
             command += ["--duration", str(duration)]
         run_command(command, out + ".log")
-    return read_json(os.path.join(out, "summary.json"))
+    return mjslam.read_sweep(out).summary
 
 
-def divergence_study(mjslam, run_dir, points, realisations, out, options):
+def divergence_study(program, run_dir, points, realisations, out, options):
     if not os.path.exists(out):
-        run_command([mjslam, "divergence", run_dir, "--points"] + [str(p) for p in points] +
+        run_command([program, "divergence", run_dir, "--points"] + [str(p) for p in points] +
                     ["--realisations", str(realisations), "--out", out] + options,
                     out + ".log")
     return figs.read_divergence(out)
@@ -171,11 +154,11 @@ def processed_consistency(traj, name):
     return {"steps": len(steps), "inside": inside, "nees_sum": nees_sum, "nees_steps": nees_steps}
 
 
-def run_metrics(run_dir):
-    """Cost, open loop (both counts), map metrics and 2 sigma of one run directory."""
-    summary = read_json(os.path.join(run_dir, "summary.json"))
-    traj = figs.read_csv(os.path.join(run_dir, "trajectory.csv"))
-    cost, dt = timing_of(run_dir)
+def run_metrics(run):
+    """Cost, open loop (both counts), map metrics and 2 sigma of one run (mjslam.Run)."""
+    summary = run.summary
+    traj = run.trajectory
+    cost, dt = timing_of(run)
     half = len(traj["t"]) // 2
     out = {"duration_s": summary["run"]["duration_s"], "divergence": summary.get("divergence")}
     for f in FILTERS:
@@ -199,33 +182,35 @@ def run_metrics(run_dir):
         if s.get("processing_s") is not None and \
                 abs(sum(modelled) - s["processing_s"]) > 1e-6 * max(1.0, s["processing_s"]):
             log("note: %s: %s processing from trajectory.csv %.6f s, summary.json %.6f s "
-                "(control.processing is not model?)" % (run_dir, f, sum(modelled),
+                "(control.processing is not model?)" % (run.path, f, sum(modelled),
                                                         s["processing_s"]))
     return out
 
 
-def model_results(args, mjslam, model):
+def model_results(args, program, model):
     """Runs (or reuses) one model's experiments; returns what the table and figures need."""
     out = os.path.join(args.out, model)
     os.makedirs(out, exist_ok=True)
     config = "configs/%s.yaml" % model
     res = {"model": model, "dir": out}
-    res["corridor"] = sweep(mjslam, config, "worlds/corridor_loop.xml", args.runs, args.jobs,
+    res["corridor"] = sweep(program, config, "worlds/corridor_loop.xml", args.runs, args.jobs,
                             os.path.join(out, "corridor"), args.duration)
-    res["office"] = sweep(mjslam, config, "worlds/office.xml", args.office_runs, args.jobs,
+    res["office"] = sweep(program, config, "worlds/office.xml", args.office_runs, args.jobs,
                           os.path.join(out, "office"), args.office_duration)
-    res["corridor_runs"] = [run_metrics(d) for d in run_dirs_of(os.path.join(out, "corridor"))]
-    res["office_runs"] = [run_metrics(d) for d in run_dirs_of(os.path.join(out, "office"))]
-    office_first = run_dirs_of(os.path.join(out, "office"))[0]
+    corridor_runs = mjslam.read_sweep(os.path.join(out, "corridor")).runs
+    office_runs = mjslam.read_sweep(os.path.join(out, "office")).runs
+    res["corridor_runs"] = [run_metrics(r) for r in corridor_runs]
+    res["office_runs"] = [run_metrics(r) for r in office_runs]
+    office_first = office_runs[0]
     res["office_first"] = office_first
-    res["corridor_first"] = run_dirs_of(os.path.join(out, "corridor"))[0]
+    res["corridor_first"] = corridor_runs[0]
     res["studies"] = {}
     for key, _, options in STUDIES:
         realisations = args.realisations
         if key == "paper" and args.paper_study_realisations is not None:
             realisations = args.paper_study_realisations
         res["studies"][key] = divergence_study(
-            mjslam, office_first, args.points, realisations,
+            program, office_first.path, args.points, realisations,
             os.path.join(out, "divergence_%s.csv" % key), options)
     return res
 
@@ -401,12 +386,12 @@ def draw_model_figures(res, fig_dir, points_margin_m=0.5):
     office = res["office_first"]
     cost, dt = timing_of(office)
     label = "%s model" % model
-    traj = figs.read_csv(os.path.join(corridor, "trajectory.csv"))
-    seed = read_json(os.path.join(corridor, "manifest.json")).get("seed")
+    traj = corridor.trajectory
+    seed = corridor.manifest.get("seed")
     figs.fig3_pose_errors(traj, os.path.join(fig_dir, "fig3_pose_errors_%s.png" % model),
                           "%s, corridor loop, seed %s" % (label, seed))
-    traj = figs.read_csv(os.path.join(office, "trajectory.csv"))
-    seed = read_json(os.path.join(office, "manifest.json")).get("seed")
+    traj = office.trajectory
+    seed = office.manifest.get("seed")
     where = "%s, office, seed %s" % (label, seed)
     figs.fig4c_processing(traj, os.path.join(fig_dir, "fig4c_processing_%s.png" % model), where,
                           cost)
@@ -421,7 +406,7 @@ def draw_model_figures(res, fig_dir, points_margin_m=0.5):
                            os.path.join(fig_dir, "fig7_to_truth_%s.png" % model),
                            "Fig. 7 of the paper: divergence of each map to the truth against #E, %s"
                            % where)
-    nees = figs.read_csv(os.path.join(res["dir"], "corridor", "nees.csv"))
+    nees = mjslam.read_sweep(os.path.join(res["dir"], "corridor")).nees
     # nees.csv (mjslam sweep) averages every step; under realtime a skipped step holds the
     # estimate of its last processed step, compared with that step's truth, so say so.
     stale = any(r[f]["processed"]["steps"] < r[f]["steps"] for r in res["corridor_runs"]
@@ -434,7 +419,7 @@ def draw_model_figures(res, fig_dir, points_margin_m=0.5):
 # ---------------------------------------------------------------------------------------------
 # Figs. 4(c)-(d) at scale (issue 12 item 5).
 
-def scale_study(args, mjslam, fig_dir):
+def scale_study(args, program, fig_dir):
     """One realtime tour per world; returns the table lines and draws fig4cd_scale.png."""
     runs, lines = [], []
     lines.append("| world | driven (run's end) | final map classical / selective | scans skipped classical / "
@@ -447,18 +432,19 @@ def scale_study(args, mjslam, fig_dir):
         duration = float(seconds) if seconds else args.scale_duration
         name = os.path.splitext(os.path.basename(world))[0]
         out = os.path.join(args.out, "scale", name)
-        if not os.path.exists(os.path.join(out, "summary.json")):
+        if not os.path.exists(os.path.join(out, mjslam.SUMMARY_FILE)):
             os.makedirs(os.path.dirname(out), exist_ok=True)
-            command = [mjslam, "run", "--config", "configs/default.yaml", "--world", world,
+            command = [program, "run", "--config", "configs/default.yaml", "--world", world,
                        "--set", "slam.timing=realtime", "--set", "control.driver=tour",
                        "--set", "driver.loop=false", "--set", "render.enabled=false",
                        "--no-render", "--no-evaluate", "--quiet", "--out", out]
             command += ["--duration", str(duration)]
             run_command(command, out + ".log")
-        traj = figs.until_last_motion(figs.read_csv(os.path.join(out, "trajectory.csv")))
-        cost, dt = timing_of(out)
+        run = mjslam.read_run(out)
+        traj = figs.until_last_motion(run.trajectory)
+        cost, dt = timing_of(run)
         runs.append((name, traj))
-        summary = read_json(os.path.join(out, "summary.json"))
+        summary = run.summary
         t = traj["t"]
         first_c = next((s for s, p in enumerate(traj["classical_period"]) if p >= 0.7 - 1e-9),
                        None)
@@ -513,18 +499,18 @@ def main():
                         "between its claims markers")
     args = parser.parse_args()
 
-    mjslam = args.mjslam if os.path.isabs(args.mjslam) else os.path.join(ROOT, args.mjslam)
-    if not os.access(mjslam, os.X_OK):
-        raise SystemExit("%s not found: build it first (cmake --build build -j2)" % mjslam)
+    program = args.mjslam if os.path.isabs(args.mjslam) else os.path.join(ROOT, args.mjslam)
+    if not os.access(program, os.X_OK):
+        raise SystemExit("%s not found: build it first (cmake --build build -j2)" % program)
     args.out = args.out if os.path.isabs(args.out) else os.path.join(ROOT, args.out)
     fig_dir = os.path.join(args.out, "figures")
     os.makedirs(fig_dir, exist_ok=True)
     start = time.monotonic()
 
-    results = {m: model_results(args, mjslam, m) for m in args.models}
+    results = {m: model_results(args, program, m) for m in args.models}
     for res in results.values():
         draw_model_figures(res, fig_dir)
-    scale_lines = scale_study(args, mjslam, fig_dir)
+    scale_lines = scale_study(args, program, fig_dir)
 
     header = "| claim | paper | " + " | ".join("%s model | verdict" % m for m in args.models) + " |"
     table = [header, "|---|---|" + "---|---|" * len(args.models)]

@@ -2,21 +2,24 @@
 """The paper's figures, one file each, drawn from mjslam run and sweep directories.
 
 Used by scripts/paper_experiments.py (which says which run feeds which figure); each function
-takes the parsed files and a PNG path. Needs Debian's python3-matplotlib, as renders/report.py.
-Every title names the paper's figure (Auat Cheein et al., Robotica 29(2), 2011) or says that the
-plot is not one of the paper's. Per-step figures come from trajectory.csv (docs/run_directory.md).
+takes the files as python/mjslam reads them (a trajectory Table, a Run) and a PNG path. Needs
+Debian's python3-matplotlib and python3-numpy, as renders/report.py. Every title names the paper's
+figure (Auat Cheein et al., Robotica 29(2), 2011) or says that the plot is not one of the paper's.
+Per-step figures come from trajectory.csv (docs/run_directory.md).
 """
 
-import csv
 import math
 import os
 import random
 import sys
 
-sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
-                                "renders"))
-# The run pages' plotting module: its CSV reader, atomic PNG writer, colours (matplotlib on Agg).
-from report import COLORS, FILTERS, plot_nees, read_csv, save, wrap  # noqa: E402,F401
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+# python/mjslam, the reader of run directories, found from this file: no build, no PYTHONPATH.
+sys.path.insert(0, os.path.join(ROOT, "python"))
+sys.path.insert(1, os.path.join(ROOT, "renders"))
+import mjslam  # noqa: E402
+# The run pages' plotting module: its atomic PNG writer, colours (matplotlib on Agg).
+from report import COLORS, FILTERS, plot_nees, save, wrap  # noqa: E402,F401
 import matplotlib  # noqa: E402
 import matplotlib.pyplot as plt  # noqa: E402
 import matplotlib.ticker  # noqa: E402
@@ -167,24 +170,18 @@ def fig4d_open_loop(traj, path, label, dt):
 # ---------------------------------------------------------------------------------------------
 # Fig. 5: the Monte Carlo points on the map.
 
-def map_segments(path):
-    """Lines (as segments) and corners of a map_*.csv or ground_truth_map.csv."""
-    m = read_csv(path)
-    lines, corners = [], []
-    for i, kind in enumerate(m["type"]):
-        if kind == "corner":
-            corners.append((m["p0"][i], m["p1"][i]))
-        elif not math.isnan(m["ax"][i]):
-            lines.append(((m["ax"][i], m["ay"][i]), (m["bx"][i], m["by"][i])))
-    return lines, corners
+def map_segments(m):
+    """Lines (as segments, [[ax, ay], [bx, by]]) and corners ([x, y]) of a map (mjslam.Map)."""
+    return m.segments.tolist(), m.corners.tolist()
 
 
-def fig5_points(run_dir, path, label, num_points, margin_m, seed):
+def fig5_points(run, path, label, num_points, margin_m, seed):
     """Fig. 5: #E points drawn uniformly in the box of the three maps (grown by the margin) over
-    the maps. An illustration: Python's generator with `seed`, not the study's draws."""
-    maps = {"truth": map_segments(os.path.join(run_dir, "ground_truth_map.csv")),
-            "classical": map_segments(os.path.join(run_dir, "map_classical.csv")),
-            "selective": map_segments(os.path.join(run_dir, "map_selective.csv"))}
+    the maps of `run` (mjslam.Run). An illustration: Python's generator with `seed`, not the
+    study's draws."""
+    maps = {"truth": map_segments(mjslam.read_map(run.file(mjslam.GROUND_TRUTH_MAP_FILE))),
+            "classical": map_segments(run.maps["classical"]),
+            "selective": map_segments(run.maps["selective"])}
     xs = [p[0] for lines, corners in maps.values() for seg in lines for p in seg] + \
          [c[0] for _, corners in maps.values() for c in corners]
     ys = [p[1] for lines, corners in maps.values() for seg in lines for p in seg] + \
@@ -221,14 +218,7 @@ def fig5_points(run_dir, path, label, num_points, margin_m, seed):
 
 def read_divergence(path):
     """{pair: [(num_points, mean, variance), ...]} of a divergence.csv, sorted by #E."""
-    table = {}
-    with open(path) as f:
-        for r in csv.DictReader(f):
-            table.setdefault(r["pair"], []).append((int(r["num_points"]), float(r["mean"]),
-                                                    float(r["variance"])))
-    for rows in table.values():
-        rows.sort()
-    return table
+    return mjslam.divergence_by_pair(mjslam.read_divergence(path))
 
 
 PAIR_LABELS = {"classical_selective": "D(classical ‖ selective)",
@@ -272,7 +262,7 @@ def until_last_motion(traj):
     the robot standing until the time limit, with nothing changing but the clock."""
     last = max((s for s, (v, w) in enumerate(zip(traj["cmd_v"], traj["cmd_w"]))
                 if v != 0.0 or w != 0.0), default=len(traj["t"]) - 1)
-    return {k: v[:last + 2] for k, v in traj.items()}
+    return traj.select(slice(0, last + 2))
 
 
 def scale_series(traj, name, cost, dt):

@@ -1,4 +1,4 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """Leave-one-log-out on the real logs: each log scored with settings chosen on the others.
 
 Usage: real_leave_one_out.py [--data DIR] [--out DIR] [--program PATH]
@@ -12,15 +12,20 @@ score on a log is the geometric mean, over both filters, the three spans and
 translation and rotation, of the filter's mean error over the wheel
 odometry's: below 1, the filters beat the odometry. For each log the setting
 with the best mean score on the other logs is chosen, and the held-out log's
-table printed with it. Python 3 standard library.
+table printed with it. Reads each import's summary.json with python/mjslam (Debian's Python 3
+with numpy, /usr/bin/python3).
 """
 import argparse
 import itertools
-import json
 import math
 import os
 import subprocess
 import sys
+
+# python/mjslam, the reader of run directories, found from this file: no build, no PYTHONPATH.
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
+                                "python"))
+import mjslam  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 LOGS = {"intel": "intel-corrected.log.gz", "fr079": "freiburg-079-corrected.log.gz"}
@@ -48,7 +53,7 @@ def score(program, log_path, sets, out_dir):
         command += ["--set", s]
     subprocess.run(command, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     subprocess.run([program, "evaluate", out_dir], check=True, stdout=subprocess.DEVNULL)
-    summary = json.load(open(os.path.join(out_dir, "summary.json")))
+    summary = mjslam.read_run(out_dir).summary
     lags = summary["real"]["vs_reference_scans_apart"]
     return {lag: lags[lag] for lag in LAGS}
 

@@ -1,9 +1,9 @@
-#!/usr/bin/env python3
+#!/usr/bin/python3
 """Statistics of laser scans, simulated or real, side by side (docs/results.md, "The SICK's error structure").
 
 For each run directory (a simulated run of `mjslam run`, or a real log turned into
-one by `mjslam import LOG --out DIR`) it reads `scans.csv` (ranges r0..r<n-1>,
-docs/run_directory.md) and the beam layout from the directory's `config.yaml`
+one by `mjslam import LOG --out DIR`) it reads, with python/mjslam, `scans.csv` (ranges
+r0..r<n-1>, docs/run_directory.md) and the beam layout from the directory's `config.yaml`
 (`laser.num_beams`, `laser.fov_deg`, `laser.max_range_m`; an import writes the log's
 layout there: 180 beams at 1 deg for Intel, 360 at 0.5 deg for FR079, 81.83 m), and
 measures in the sensor frame, scan by scan (no poses needed):
@@ -38,7 +38,7 @@ Thresholds are the same for every data set; the real logs' ranges are in whole
 centimetres (the SICK's cm mode), so their residuals carry 1 cm / sqrt(12) = 2.9 mm of
 quantisation on top of the sensor's noise.
 
-Usage (Debian's Python 3 with numpy and matplotlib, /usr/bin/python3):
+Usage (Debian's Python 3 with numpy, PyYAML and matplotlib, /usr/bin/python3):
     scripts/scan_statistics.py [--max-scans N] [--out FIG.png] [--csv TABLE.csv] \\
         LABEL=RUN_DIR [LABEL=RUN_DIR ...]
 Prints a table (one row per data set) and writes the figure (three panels: residual
@@ -51,6 +51,11 @@ import os
 import sys
 
 import numpy as np
+
+# python/mjslam, the reader of run directories, found from this file: no build, no PYTHONPATH.
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
+                                "python"))
+import mjslam  # noqa: E402
 
 BREAK_M = 0.05          # base of the break distance between neighbours
 BREAK_STEPS = 20.0      # ... plus this many beam steps of arc at the range
@@ -65,33 +70,24 @@ RANGE_BINS = [0.0, 1.0, 2.0, 4.0, 8.0, 16.0, 1000.0]
 INCIDENCE_BINS_DEG = [0.0, 30.0, 50.0, 60.0, 70.0, 75.0, 80.0, 85.0, 90.0]
 
 
-def read_layout(run_dir):
+def read_layout(run):
     """num_beams, fov_deg, max_range_m of the run's laser, from its config.yaml."""
     layout = {"num_beams": 181, "fov_deg": 180.0, "max_range_m": 30.0}
-    path = os.path.join(run_dir, "config.yaml")
-    import yaml  # python3-yaml, installed by scripts/setup.sh
-    with open(path) as f:
-        laser = (yaml.safe_load(f) or {}).get("laser", {})
     for key in layout:
-        if key not in laser:
-            raise SystemExit("%s: laser.%s missing" % (path, key))
-        layout[key] = type(layout[key])(laser[key])
+        try:
+            layout[key] = type(layout[key])(run.setting("laser." + key))
+        except KeyError:
+            raise SystemExit("%s: laser.%s missing" % (run.file(mjslam.CONFIG_FILE), key))
     return layout
 
 
-def read_scans(run_dir, max_scans):
+def read_scans(run, max_scans):
     """The ranges of (at most max_scans, evenly spread) scans, one row each."""
-    rows = []
-    with open(os.path.join(run_dir, "scans.csv")) as f:
-        reader = csv.reader(f)
-        header = next(reader)
-        first = header.index("r0")
-        for row in reader:
-            rows.append(row[first:])
-    if max_scans and len(rows) > max_scans:
-        keep = np.linspace(0, len(rows) - 1, max_scans).round().astype(int)
-        rows = [rows[i] for i in keep]
-    return np.array(rows, dtype=float), len(rows)
+    ranges = run.scans.ranges
+    if max_scans and len(ranges) > max_scans:
+        keep = np.linspace(0, len(ranges) - 1, max_scans).round().astype(int)
+        ranges = ranges[keep]
+    return ranges, len(ranges)
 
 
 def split_and_merge(points, lo, hi, out):
@@ -256,8 +252,9 @@ def main():
         label, _, run_dir = spec.partition("=")
         if not run_dir:
             sys.exit(f"expected LABEL=RUN_DIR, got {spec}")
-        layout = read_layout(run_dir)
-        ranges, used = read_scans(run_dir, args.max_scans)
+        run = mjslam.read_run(run_dir)
+        layout = read_layout(run)
+        ranges, used = read_scans(run, args.max_scans)
         s = scan_statistics(ranges, layout)
         results.append((label, layout, used, summarise(s)))
 

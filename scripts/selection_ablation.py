@@ -16,24 +16,28 @@ per model and policy, the selective filter's mean ANEES, the fraction of steps w
 inside its 95 % bounds, the fractions inside 2 sigma per component, the pose RMSE and the map's
 line rho / corner RMSE (means over the runs). A sweep whose summary.json exists is not rerun.
 
-Python 3 standard library only.
+Reads the sweeps' summary.json with python/mjslam (Debian's Python 3 with numpy).
 """
 
 import argparse
-import json
 import os
 import subprocess
 import sys
+
+# python/mjslam, the reader of run directories, found from this file: no build, no PYTHONPATH.
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))),
+                                "python"))
+import mjslam  # noqa: E402
 
 MODELS = ("default", "paper")
 POLICIES = ("criterion", "first", "random", "least_informative", "determinant")
 
 
-def run_sweep(mjslam, model, policy, args, out):
+def run_sweep(program, model, policy, args, out):
     """Runs one sweep into `out` unless its summary.json exists; returns the summary."""
-    summary = os.path.join(out, "summary.json")
-    if not os.path.exists(summary):
-        command = [mjslam, "sweep", "--config", "configs/%s.yaml" % model, "--runs", str(args.runs),
+    sweep = mjslam.read_sweep(out)
+    if not sweep.has(mjslam.SUMMARY_FILE):
+        command = [program, "sweep", "--config", "configs/%s.yaml" % model, "--runs", str(args.runs),
                    "--jobs", str(args.jobs), "--out", out, "--quiet",
                    "--set", "control.pose_source=odometry",
                    "--set", "slam.ekf.selection_policy=%s" % policy]
@@ -41,8 +45,7 @@ def run_sweep(mjslam, model, policy, args, out):
             command += ["--duration", str(args.duration)]
         print(" ".join(command), flush=True)
         subprocess.run(command, check=True, stdout=subprocess.DEVNULL)
-    with open(summary) as f:
-        return json.load(f)
+    return sweep.summary
 
 
 def row(model, name, filt):

@@ -18,7 +18,9 @@ packages=(
   libpng-dev           # libpng: final.png of the renders
   ffmpeg               # ffmpeg/ffprobe: video.mp4 of the renders (H.264), its test
   python3-matplotlib   # matplotlib: the plots of runs and sweeps (renders/report.py)
-  python3-yaml         # PyYAML: run directories' config.yaml in scripts/scan_statistics.py
+  python3-yaml         # PyYAML: run directories' config.yaml (python/mjslam, the scripts)
+  python3-numpy        # numpy: the columns of run files in Python (python/mjslam, the scripts)
+  python3-pytest       # pytest: the tests of the Python package (tests/python)
   chromium             # headless Chromium: the test that index.html loads
   slurm-wlm munge      # Slurm: the one-node cluster of the sweep's Slurm test (scripts/slurm_localhost.sh)
 )
