@@ -13,6 +13,9 @@ namespace {
 
 // Smallest eigenvalue of a covariance with a NEES, relative to the largest.
 constexpr double kMinEigenvalueRatio = 1e-12;
+// Below this (m^2 or rad^2; a nanometre, a nanoradian) every variance is
+// rounding of P = 0: the known start.
+constexpr double kMinVariance = 1e-18;
 
 }  // namespace
 
@@ -26,11 +29,13 @@ PoseStepMetrics EvaluatePoseStep(const Pose2& X_W_true, const Pose2& X_W_estimat
     m.inside_2sigma[k] = std::abs(m.error(k)) <= 2.0 * sigma + 1e-12;
   }
   // Rank-deficient covariances (the first prediction from the known start adds
-  // a rank-2 input noise to P = 0) have no NEES: their inverse is rounding.
+  // a rank-2 input noise to P = 0), and those that are rounding of P = 0, have
+  // no NEES: their inverse is rounding.
   const Eigen::Vector3d eigenvalues =
       Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(P_pose, Eigen::EigenvaluesOnly).eigenvalues();
   const Eigen::LLT<Eigen::Matrix3d> llt(P_pose);
-  if (llt.info() == Eigen::Success && eigenvalues(0) > kMinEigenvalueRatio * eigenvalues(2)) {
+  if (llt.info() == Eigen::Success && eigenvalues(2) > kMinVariance &&
+      eigenvalues(0) > kMinEigenvalueRatio * eigenvalues(2)) {
     const Eigen::Vector3d whitened = llt.matrixL().solve(m.error);
     m.nees = whitened.squaredNorm();
   } else {

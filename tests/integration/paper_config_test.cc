@@ -23,6 +23,9 @@ void ExpectPaperChoices(const app::RunConfig& config) {
   EXPECT_EQ(ekf.input, "command");
   EXPECT_EQ(ekf.motion_integration, "euler");
   EXPECT_EQ(ekf.lateral_slip_std_m_per_rad, 0.0);
+  EXPECT_EQ(ekf.lateral_slip_std_m_per_sqrt_m, 0.0);
+  EXPECT_EQ(ekf.line_match_max_gap_m, 0.0);
+  EXPECT_EQ(ekf.self_calibration.wheel_slip_drift_std_per_sqrt_m, 0.0);
   EXPECT_EQ(ekf.lateral_skid_s, 0.0);
   EXPECT_TRUE(ekf.correct_corners_of_matched_lines);
   EXPECT_FALSE(ekf.corners_from_map_lines);
