@@ -252,12 +252,15 @@ Calibration Calibrate(const std::vector<RunMotion>& runs, const slam::EkfParams&
                                 " records: expected at least 50 (give more or longer runs)");
   }
   const int n = static_cast<int>(windows.size());
-  Eigen::MatrixXd X3(n, 3);
+  // The slip's variance grows with the distance rolled and the angle turned;
+  // a floor per record would make the model depend on the record rate, and
+  // is left at 0.
+  Eigen::MatrixXd X3(n, 2);
   Eigen::MatrixXd X2(n, 2);
   Eigen::VectorXd yd(n), yth(n), ylat(n);
   for (int i = 0; i < n; ++i) {
     const WindowSums& w = windows[i];
-    X3.row(i) << w.records, w.distance, w.turn;
+    X3.row(i) << w.distance, w.turn;
     X2.row(i) << w.distance, w.turn2;
     yd(i) = w.e_d * w.e_d;
     yth(i) = w.e_th * w.e_th;
@@ -267,12 +270,12 @@ Calibration Calibrate(const std::vector<RunMotion>& runs, const slam::EkfParams&
   const Eigen::VectorXd cth = FitVariance(X3, yth);
   const Eigen::VectorXd clat = FitVariance(X2, ylat);
   slam::OdometryNoiseParams& noise = result.fitted.odometry_noise;
-  noise.distance_noise_std_m = Round3(std::sqrt(cd(0)));
-  noise.distance_noise_std_m_per_sqrt_m = Round3(std::sqrt(cd(1)));
-  noise.distance_noise_std_m_per_sqrt_rad = Round3(std::sqrt(cd(2)));
-  noise.heading_noise_std_rad = Round3(std::sqrt(cth(0)));
-  noise.heading_noise_std_rad_per_sqrt_m = Round3(std::sqrt(cth(1)));
-  noise.heading_noise_std_rad_per_sqrt_rad = Round3(std::sqrt(cth(2)));
+  noise.distance_noise_std_m = 0.0;
+  noise.distance_noise_std_m_per_sqrt_m = Round3(std::sqrt(cd(0)));
+  noise.distance_noise_std_m_per_sqrt_rad = Round3(std::sqrt(cd(1)));
+  noise.heading_noise_std_rad = 0.0;
+  noise.heading_noise_std_rad_per_sqrt_m = Round3(std::sqrt(cth(0)));
+  noise.heading_noise_std_rad_per_sqrt_rad = Round3(std::sqrt(cth(1)));
   result.fitted.lateral_slip_std_m_per_sqrt_m = Round3(std::sqrt(clat(0)));
   result.fitted.lateral_slip_std_m_per_rad = Round3(std::sqrt(clat(1)));
   for (int size : {1, window_records, 5 * window_records}) {

@@ -64,7 +64,8 @@ struct Calibration {
 ///   2. per run, the systematic part, least squares: d -> q_d d + k B^2/4
 ///      dth, dth -> q_th dth + k d (what self-calibration estimates), and
 ///      the skid (lateral_skid_s) pooled over the runs; both removed;
-///   3. the variances of OdometryNoiseParams and the lateral slip fitted,
+///   3. the variances of OdometryNoiseParams (per metre and per radian; the
+///      floors per record are set to 0) and the lateral slip fitted,
 ///      non-negative, to the remaining errors summed over windows of
 ///      `window_records` records (iteratively reweighted least squares of
 ///      the squared sums: errors correlated over a window count as such);
