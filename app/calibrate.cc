@@ -4,9 +4,11 @@
 #include <array>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <limits>
 #include <stdexcept>
+#include <string>
 
 #include <Eigen/Dense>
 
@@ -171,11 +173,14 @@ void RequireFinitePose(const Pose2& pose, const RunMotion& run, std::size_t i, c
   }
 }
 
-double Round3(double value) {
+// Three significant digits: what the fit can tell, and what --write writes.
+std::string Text3(double value) {
   char text[32];
   std::snprintf(text, sizeof text, "%.3g", value);
-  return std::strtod(text, nullptr);
+  return text;
 }
+
+double Round3(double value) { return std::strtod(Text3(value).c_str(), nullptr); }
 
 }  // namespace
 
@@ -334,11 +339,6 @@ std::string CalibrationYaml(const Calibration& calibration, const std::string& b
                             const std::string& header) {
   const slam::EkfParams& p = calibration.fitted;
   const slam::OdometryNoiseParams& n = p.odometry_noise;
-  auto number = [](double value) {
-    char text[32];
-    std::snprintf(text, sizeof text, "%.3g", value);
-    return std::string(text);
-  };
   std::string yaml;
   for (std::size_t start = 0; start < header.size();) {
     const std::size_t end = header.find('\n', start);
@@ -348,18 +348,18 @@ std::string CalibrationYaml(const Calibration& calibration, const std::string& b
   }
   if (!base.empty()) yaml += "base: " + base + "\n";
   yaml += "slam:\n  ekf:\n    odometry_noise:\n";
-  yaml += "      distance_noise_std_m: " + number(n.distance_noise_std_m) + "\n";
-  yaml += "      distance_noise_std_m_per_sqrt_m: " + number(n.distance_noise_std_m_per_sqrt_m) + "\n";
-  yaml += "      distance_noise_std_m_per_sqrt_rad: " + number(n.distance_noise_std_m_per_sqrt_rad) +
+  yaml += "      distance_noise_std_m: " + Text3(n.distance_noise_std_m) + "\n";
+  yaml += "      distance_noise_std_m_per_sqrt_m: " + Text3(n.distance_noise_std_m_per_sqrt_m) + "\n";
+  yaml += "      distance_noise_std_m_per_sqrt_rad: " + Text3(n.distance_noise_std_m_per_sqrt_rad) +
           "\n";
-  yaml += "      heading_noise_std_rad: " + number(n.heading_noise_std_rad) + "\n";
-  yaml += "      heading_noise_std_rad_per_sqrt_m: " + number(n.heading_noise_std_rad_per_sqrt_m) +
+  yaml += "      heading_noise_std_rad: " + Text3(n.heading_noise_std_rad) + "\n";
+  yaml += "      heading_noise_std_rad_per_sqrt_m: " + Text3(n.heading_noise_std_rad_per_sqrt_m) +
           "\n";
   yaml += "      heading_noise_std_rad_per_sqrt_rad: " +
-          number(n.heading_noise_std_rad_per_sqrt_rad) + "\n";
-  yaml += "    lateral_slip_std_m_per_rad: " + number(p.lateral_slip_std_m_per_rad) + "\n";
-  yaml += "    lateral_slip_std_m_per_sqrt_m: " + number(p.lateral_slip_std_m_per_sqrt_m) + "\n";
-  yaml += "    lateral_skid_s: " + number(p.lateral_skid_s) + "\n";
+          Text3(n.heading_noise_std_rad_per_sqrt_rad) + "\n";
+  yaml += "    lateral_slip_std_m_per_rad: " + Text3(p.lateral_slip_std_m_per_rad) + "\n";
+  yaml += "    lateral_slip_std_m_per_sqrt_m: " + Text3(p.lateral_slip_std_m_per_sqrt_m) + "\n";
+  yaml += "    lateral_skid_s: " + Text3(p.lateral_skid_s) + "\n";
   return yaml;
 }
 
