@@ -12,7 +12,7 @@
 
 #include "app/run_pool.h"
 #include "config/config.h"
-#include "eval/chi_square.h"
+#include "common/chi_square.h"
 #include "common/interrupt.h"
 #include "rundir/csv_reader.h"
 #include "rundir/csv_writer.h"
@@ -494,7 +494,7 @@ NeesCounts WriteAverageNees(const SweepRuns& runs, const std::string& out_dir,
     }
     if (n == 0 || !defined) continue;
     ++counts.used_steps;
-    const eval::Interval bounds = eval::AverageNeesBounds(n, 3, options.bounds_probability);
+    const Interval bounds = AverageNeesBounds(n, 3, options.bounds_probability);
     csv += FormatDouble(t);
     for (std::size_t f = 0; f < num_filters; ++f) {
       const double anees = sum[f] / n;

@@ -7,7 +7,7 @@
 #include <Eigen/Cholesky>
 
 #include "common/angles.h"
-#include "eval/chi_square.h"
+#include "common/chi_square.h"
 
 namespace mjslam::eval {
 

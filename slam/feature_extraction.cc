@@ -28,6 +28,8 @@ std::vector<ParamProblem> FeatureExtractionParams::Validate() const {
   // Below a few noise deviations, noise alone splits walls into short pieces.
   check.Require(!(split_distance_m < 3.0 * range_noise_std_m), "split_distance_m",
                 split_distance_m, "a value >= 3 * range_noise_std_m");
+  check.Require(fit_test_probability >= 0.0 && fit_test_probability < 1.0, "fit_test_probability",
+                fit_test_probability, "a value in [0, 1)");
   finite_positive("outlier_gate_sigmas", outlier_gate_sigmas);
   check.Require(min_points >= 2, "min_points", min_points, "a value >= 2");
   finite_non_negative("min_length_m", min_length_m);
@@ -92,6 +94,7 @@ ScanFeatures ExtractFeatures(const LaserScan& scan, const FeatureExtractionParam
   const std::vector<ClusterBounds> clusters = FindClusters(points, increment, params);
   std::vector<Segment> runs = SplitClusters(points, clusters, params.split_distance_m);
   MergeRuns(points, noise, params.split_distance_m, &runs);
+  SplitInconsistentRuns(points, noise, params.fit_test_probability, &runs);
 
   // Points to lines: vertex points to none, a first fit, then trimmed and
   // grown ends.

@@ -43,6 +43,13 @@ struct FeatureExtractionParams {
   /// this distance of the union's fitted line. At least 3 range noise
   /// deviations (noise alone would split walls); 6 or more is better.
   double split_distance_m = 0.03;
+  /// The fit test after split-and-merge: a run whose points fit their line
+  /// worse than this quantile of chi-square (points - 2 dof, residuals in
+  /// standard deviations of the noise model above) is split where two lines
+  /// fit best. A step of a few centimetres between parallel walls passes the
+  /// chord test of `split_distance_m` and would become one tilted line with
+  /// a covariance far too small. In [0, 1); 0 turns the test off.
+  double fit_test_probability = 0.99999;
   /// An end point of a line whose distance to the fitted line exceeds this
   /// many standard deviations of its perpendicular noise is dropped (and the
   /// line refitted); so is an end point next to a neighbouring line that is
@@ -81,6 +88,7 @@ struct FeatureExtractionParams {
     a->Visit(MJSLAM_NVP(break_noise_sigmas));
     a->Visit(MJSLAM_NVP(max_missing_beams));
     a->Visit(MJSLAM_NVP(split_distance_m));
+    a->Visit(MJSLAM_NVP(fit_test_probability));
     a->Visit(MJSLAM_NVP(outlier_gate_sigmas));
     a->Visit(MJSLAM_NVP(min_points));
     a->Visit(MJSLAM_NVP(min_length_m));

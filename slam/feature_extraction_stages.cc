@@ -4,8 +4,11 @@
 #include <cmath>
 #include <cstddef>
 #include <limits>
+#include <utility>
+#include <vector>
 
 #include "common/angles.h"
+#include "common/chi_square.h"
 
 namespace mjslam::slam::extraction {
 namespace {
@@ -458,6 +461,122 @@ void MergeRuns(const std::vector<ScanPoint>& points, const NoiseModel& noise,
     if (i + 1 < runs.size()) union_cost[i] = merge_cost(i);
     if (i > 0) union_cost[i - 1] = merge_cost(i - 1);
   }
+}
+
+namespace {
+
+// Sum of squared normalised residuals of points [first, last] about `fit`.
+double FitChiSquare(const std::vector<ScanPoint>& points, int first, int last, const LineFit& fit,
+                    const NoiseModel& noise) {
+  double sum = 0.0;
+  for (int i = first; i <= last; ++i) {
+    const double r = NormalizedResidual(fit, points[i], noise);
+    sum += r * r;
+  }
+  return sum;
+}
+
+// The chi-square quantile of `probability` for `dof` degrees of freedom,
+// remembered per dof (the probability is one per configuration).
+double CachedChiSquareQuantile(double probability, int dof) {
+  thread_local double cached_probability = -1.0;
+  thread_local std::vector<double> quantiles;
+  if (probability != cached_probability) {
+    cached_probability = probability;
+    quantiles.clear();
+  }
+  if (static_cast<int>(quantiles.size()) <= dof) {
+    quantiles.resize(static_cast<std::size_t>(dof) + 1, -1.0);
+  }
+  double& q = quantiles[static_cast<std::size_t>(dof)];
+  if (q < 0.0) q = ChiSquareQuantile(probability, dof);
+  return q;
+}
+
+// Sum of squared distances of n points to their total-least-squares line,
+// from their sums: the smaller eigenvalue of the centred scatter matrix.
+double TotalLeastSquaresResidual(double n, double sx, double sy, double sxx, double syy,
+                                 double sxy) {
+  const double cxx = sxx - sx * sx / n;
+  const double cyy = syy - sy * sy / n;
+  const double cxy = sxy - sx * sy / n;
+  const double half_trace = 0.5 * (cxx + cyy);
+  const double half_difference = 0.5 * (cxx - cyy);
+  return std::max(0.0, half_trace - std::sqrt(half_difference * half_difference + cxy * cxy));
+}
+
+// The point k in (first, last) where lines over [first, k] and [k, last] (at
+// least 2 points each side besides k) fit best, by prefix sums: O(points).
+// -1 when the run has fewer than 5 points.
+int BestSplitPoint(const std::vector<ScanPoint>& points, int first, int last) {
+  const int n = last - first + 1;
+  if (n < 5) return -1;
+  // Prefix sums about the first point (well conditioned).
+  const double x0 = points[first].x;
+  const double y0 = points[first].y;
+  std::vector<double> sx(n + 1, 0.0), sy(n + 1, 0.0), sxx(n + 1, 0.0), syy(n + 1, 0.0),
+      sxy(n + 1, 0.0);
+  for (int j = 0; j < n; ++j) {
+    const double x = points[first + j].x - x0;
+    const double y = points[first + j].y - y0;
+    sx[j + 1] = sx[j] + x;
+    sy[j + 1] = sy[j] + y;
+    sxx[j + 1] = sxx[j] + x * x;
+    syy[j + 1] = syy[j] + y * y;
+    sxy[j + 1] = sxy[j] + x * y;
+  }
+  // Sums over points [a, b] (offsets from first, inclusive).
+  const auto residual = [&](int a, int b) {
+    return TotalLeastSquaresResidual(b - a + 1, sx[b + 1] - sx[a], sy[b + 1] - sy[a],
+                                     sxx[b + 1] - sxx[a], syy[b + 1] - syy[a],
+                                     sxy[b + 1] - sxy[a]);
+  };
+  int best = -1;
+  double best_residual = std::numeric_limits<double>::infinity();
+  for (int k = 2; k <= n - 3; ++k) {
+    const double total = residual(0, k) + residual(k, n - 1);
+    if (total < best_residual) {
+      best_residual = total;
+      best = first + k;
+    }
+  }
+  return best;
+}
+
+// The test leaves out the run's end points: a split point shared with the
+// neighbouring run may lie on the other wall, and steps 5 take it (and
+// outlying ends) from the line anyway.
+void SplitIfInconsistent(const std::vector<ScanPoint>& points, const NoiseModel& noise,
+                         double probability, const Segment& run, std::vector<Segment>* out) {
+  const int first = run.first + 1;
+  const int last = run.last - 1;
+  const int dof = last - first + 1 - 2;
+  const int k = dof >= 3 ? BestSplitPoint(points, run.first, run.last) : -1;
+  if (k >= 0) {
+    const LineFit fit = FitLine(points, first, last, noise);
+    if (fit.ok && FitChiSquare(points, first, last, fit, noise) >
+                      CachedChiSquareQuantile(probability, dof)) {
+      Segment left = run;
+      left.last = k;
+      Segment right = run;
+      right.first = k;
+      SplitIfInconsistent(points, noise, probability, left, out);
+      SplitIfInconsistent(points, noise, probability, right, out);
+      return;
+    }
+  }
+  out->push_back(run);
+}
+
+}  // namespace
+
+void SplitInconsistentRuns(const std::vector<ScanPoint>& points, const NoiseModel& noise,
+                           double probability, std::vector<Segment>* runs) {
+  if (probability <= 0.0) return;
+  std::vector<Segment> split;
+  split.reserve(runs->size());
+  for (const Segment& run : *runs) SplitIfInconsistent(points, noise, probability, run, &split);
+  *runs = std::move(split);
 }
 
 std::vector<char> SeparateVertexPoints(int point_count, std::vector<Segment>* runs_in) {

@@ -113,6 +113,18 @@ std::vector<Segment> SplitClusters(const std::vector<ScanPoint>& points,
 void MergeRuns(const std::vector<ScanPoint>& points, const NoiseModel& noise,
                double split_distance_m, std::vector<Segment>* runs);
 
+/// Fit test (step 4b): a run whose points do not fit one line, whose sum of
+/// squared normalised residuals about its weighted fit (end points left out:
+/// a shared split point may lie on the other wall) exceeds the
+/// `probability` quantile of chi-square with (those points - 2) dof, is split at
+/// the point where two total-least-squares lines over its two parts (sharing
+/// that point, as a split does) leave the smallest sum of squared distances;
+/// each part is tested again. Catches a step between parallel walls a few
+/// centimetres apart that the chord test of the split misses and the merge
+/// joins. `probability` 0 leaves the runs as they are.
+void SplitInconsistentRuns(const std::vector<ScanPoint>& points, const NoiseModel& noise,
+                           double probability, std::vector<Segment>* runs);
+
 /// Vertex points (step 5): a point shared by two neighbouring runs of one
 /// cluster (a split point, nearest the vertex) is taken from both. Returns,
 /// per point of the `point_count`, 1 for such a vertex point, else 0.

@@ -9,7 +9,7 @@
 #include <gtest/gtest.h>
 
 #include "app/sweep.h"
-#include "eval/chi_square.h"
+#include "common/chi_square.h"
 #include "rundir/csv_reader.h"
 #include "rundir/layout.h"
 
@@ -65,8 +65,8 @@ TEST(SweepAggregateTest, AveragesTheNeesColumnsAgainstTheBoundsOfTheRunsPresent)
   EXPECT_EQ(nees.rows[0][2], 3.0);  // (2 + 4) / 2
   EXPECT_EQ(nees.rows[0][5], 2.0);
   EXPECT_EQ(nees.rows[2][5], 1.0);  // only run a reaches step 3
-  const eval::Interval two = eval::AverageNeesBounds(2, 3);
-  const eval::Interval one = eval::AverageNeesBounds(1, 3);
+  const Interval two = AverageNeesBounds(2, 3);
+  const Interval one = AverageNeesBounds(1, 3);
   EXPECT_EQ(nees.rows[0][3], two.lower);
   EXPECT_EQ(nees.rows[0][4], two.upper);
   EXPECT_EQ(nees.rows[2][3], one.lower);

@@ -6,7 +6,7 @@
 
 #include "common/angles.h"
 #include "common/rng.h"
-#include "eval/chi_square.h"
+#include "common/chi_square.h"
 #include "eval/map_matching.h"
 #include "eval/pose_metrics.h"
 

@@ -7,6 +7,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <random>
 #include <vector>
 
 #include <Eigen/LU>
@@ -104,6 +105,7 @@ Lines LinesOf(const LaserScan& scan, const FeatureExtractionParams& params) {
   out.clusters = FindClusters(out.points, scan.angle_increment_rad, params);
   out.runs = SplitClusters(out.points, out.clusters, params.split_distance_m);
   MergeRuns(out.points, noise, params.split_distance_m, &out.runs);
+  SplitInconsistentRuns(out.points, noise, params.fit_test_probability, &out.runs);
   const std::vector<char> is_vertex =
       SeparateVertexPoints(static_cast<int>(out.points.size()), &out.runs);
   FitRuns(out.points, noise, params.min_points, &out.runs);
@@ -230,6 +232,64 @@ TEST(MergeRunsTest, KeepsTheTwoWallsOfACorner) {
   std::vector<Segment> runs = {RunOf(0, 5, 0), RunOf(5, 10, 0)};
   MergeRuns(points, MakeNoiseModel(params), params.split_distance_m, &runs);
   EXPECT_EQ(runs.size(), 2u);
+}
+
+// ---------------------------------------------------------------------------
+// Fit test (step 4b).
+
+// A wall x = 2 seen from y = -2 to 1.9 (40 points), then a parallel wall
+// `step_m` further away for 8 points: a pilaster or a thicker wall beside it.
+std::vector<ScanPoint> SteppedWall(double step_m) {
+  std::vector<ScanPoint> points = PointsAlong(2.0, -2.0, 0.0, 0.1, 40);
+  Append(PointsAlong(2.0 + step_m, 2.0, 0.0, 0.1, 8, 40), &points);
+  return points;
+}
+
+TEST(SplitInconsistentRunsTest, SplitsAStepThatTheChordTestMerges) {
+  const FeatureExtractionParams params;
+  const NoiseModel noise = MakeNoiseModel(params);
+  const std::vector<ScanPoint> points = SteppedWall(0.05);
+  // The merge of split-and-merge joins the two walls into one (tilted) run.
+  std::vector<Segment> runs = {RunOf(0, 39, 0), RunOf(39, 47, 0)};
+  MergeRuns(points, noise, params.split_distance_m, &runs);
+  ASSERT_EQ(runs.size(), 1u);
+  SplitInconsistentRuns(points, noise, params.fit_test_probability, &runs);
+  ASSERT_EQ(runs.size(), 2u);
+  // Split at the last point of the near wall or the first of the far one,
+  // shared by both runs as a split point is.
+  EXPECT_EQ(runs[0].first, 0);
+  EXPECT_EQ(runs[1].last, 47);
+  EXPECT_EQ(runs[0].last, runs[1].first);
+  EXPECT_GE(runs[0].last, 39);
+  EXPECT_LE(runs[0].last, 40);
+  EXPECT_EQ(runs[1].cluster, 0);
+}
+
+TEST(SplitInconsistentRunsTest, KeepsNoisyStraightWallsWholeAndIsOffAtZero) {
+  FeatureExtractionParams params;
+  const NoiseModel noise = MakeNoiseModel(params);
+  // 100 walls of 60 points with range noise of the model's size: at 0.999 a
+  // wall is split with probability 0.001 (a fixed seed: the count is exact).
+  std::mt19937 engine(7);
+  std::normal_distribution<double> normal(0.0, params.range_noise_std_m);
+  int split = 0;
+  for (int wall = 0; wall < 100; ++wall) {
+    std::vector<ScanPoint> points;
+    for (int i = 0; i < 60; ++i) {
+      const double phi = DegToRad(-30.0 + i);
+      const double range = RangeToLine(3.0, 0.0, phi) + normal(engine);
+      points.push_back(Point(range * std::cos(phi), range * std::sin(phi), i));
+    }
+    std::vector<Segment> runs = {RunOf(0, 59, 0)};
+    SplitInconsistentRuns(points, noise, params.fit_test_probability, &runs);
+    if (runs.size() != 1u) ++split;
+  }
+  EXPECT_LE(split, 1);
+  params.fit_test_probability = 0.0;
+  const std::vector<ScanPoint> points = SteppedWall(0.05);
+  std::vector<Segment> runs = {RunOf(0, 47, 0)};
+  SplitInconsistentRuns(points, noise, params.fit_test_probability, &runs);
+  EXPECT_EQ(runs.size(), 1u);
 }
 
 // ---------------------------------------------------------------------------

@@ -217,7 +217,7 @@ TEST(FeatureExtractionParamsTest, SerializesEveryFieldOnce) {
   const std::vector<std::string> expected = {
       "range_noise_std_m",   "bearing_noise_std_deg",    "break_min_incidence_deg",
       "break_noise_sigmas",  "max_missing_beams",        "split_distance_m",
-      "outlier_gate_sigmas", "min_points",               "min_length_m",
+      "fit_test_probability", "outlier_gate_sigmas", "min_points",               "min_length_m",
       "line_rho_floor_std_m", "line_alpha_floor_std_deg", "corner_min_angle_deg",
       "corner_max_endpoint_distance_m", "corner_endpoint_spacings"};
   EXPECT_EQ(recorder.names, expected);

@@ -1,6 +1,6 @@
 #pragma once
 
-namespace mjslam::eval {
+namespace mjslam {
 
 /// P(X <= x) for X chi-square with `dof` degrees of freedom (dof > 0, x >= 0;
 /// 0 for x <= 0). The regularised lower incomplete gamma function P(dof/2,
@@ -29,4 +29,4 @@ struct Interval {
 /// (checked).
 Interval AverageNeesBounds(int num_runs, int dof, double probability = 0.95);
 
-}  // namespace mjslam::eval
+}  // namespace mjslam

@@ -1,10 +1,10 @@
-#include "eval/chi_square.h"
+#include "common/chi_square.h"
 
 #include <cmath>
 
 #include "common/check.h"
 
-namespace mjslam::eval {
+namespace mjslam {
 namespace {
 
 // Regularised lower incomplete gamma P(a, x), a > 0, x >= 0.
@@ -72,4 +72,4 @@ Interval AverageNeesBounds(int num_runs, int dof, double probability) {
           ChiSquareQuantile(1.0 - tail, total_dof) / num_runs};
 }
 
-}  // namespace mjslam::eval
+}  // namespace mjslam
