@@ -268,8 +268,8 @@ TEST(SplitInconsistentRunsTest, SplitsAStepThatTheChordTestMerges) {
 TEST(SplitInconsistentRunsTest, KeepsNoisyStraightWallsWholeAndIsOffAtZero) {
   FeatureExtractionParams params;
   const NoiseModel noise = MakeNoiseModel(params);
-  // 100 walls of 60 points with range noise of the model's size: at 0.999 a
-  // wall is split with probability 0.001 (a fixed seed: the count is exact).
+  // 100 walls of 60 points with range noise of the model's size: at the
+  // default 0.99999 a wall is split with probability 1e-5 (a fixed seed).
   std::mt19937 engine(7);
   std::normal_distribution<double> normal(0.0, params.range_noise_std_m);
   int split = 0;
