@@ -263,6 +263,17 @@ void ReadArchive::Finish() {
 
     // A key that no field visited: list the known ones, suggest the closest.
     if (std::find(known_.begin(), known_.end(), entry.key) != known_.end()) continue;
+
+    // A key the struct once read: name the key that replaced it.
+    const auto retired = std::find_if(retired_.begin(), retired_.end(),
+                                      [&](const RetiredKey& r) { return entry.key == r.key; });
+    if (retired != retired_.end()) {
+      const std::string note = retired->note;
+      context_->Problem(entry.key_mark, key,
+                        "a retired key, now " + JoinKey(prefix_, retired->replacement) +
+                            (note.empty() ? "" : " (" + note + ")"));
+      continue;
+    }
     std::string message = "unknown key";
     std::size_t best_distance = std::numeric_limits<std::size_t>::max();
     const std::string* best = nullptr;

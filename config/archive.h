@@ -47,6 +47,13 @@ struct IsArray : std::false_type {};
 template <typename U, std::size_t N>
 struct IsArray<std::array<U, N>> : std::true_type {};
 
+/// Whether T lists keys it no longer reads (`static constexpr RetiredKey
+/// kRetiredKeys[]`).
+template <typename T, typename = void>
+struct HasRetiredKeys : std::false_type {};
+template <typename T>
+struct HasRetiredKeys<T, std::void_t<decltype(T::kRetiredKeys)>> : std::true_type {};
+
 /// A tagged choice: a `std::variant` of Params structs, each with
 /// `static constexpr const char* kKind`, the name its YAML map gives under
 /// `kind:` (Drake's variant by tag).
@@ -179,8 +186,13 @@ class ReadArchive {
     }
   }
 
-  /// After Serialize: reports duplicate keys and keys no field visited
-  /// (listing the known keys of this level).
+  /// Names a key the struct no longer reads: Finish reports it with its
+  /// replacement instead of as unknown.
+  void Retire(const RetiredKey& retired) { retired_.push_back(retired); }
+
+  /// After Serialize: reports duplicate keys, retired keys (with the key
+  /// that replaced each) and keys no field visited (listing the known keys
+  /// of this level).
   void Finish();
 
  private:
@@ -188,7 +200,19 @@ class ReadArchive {
   std::string prefix_;
   ReadContext* context_;
   std::vector<std::string> known_;
+  std::vector<RetiredKey> retired_;
 };
+
+/// Reads the fields of the Params `*params` from `archive`'s map, then
+/// reports that map's retired, duplicate and unknown keys.
+template <typename T>
+void ReadFields(ReadArchive* archive, T* params) {
+  params->Serialize(archive);
+  if constexpr (HasRetiredKeys<T>::value) {
+    for (const RetiredKey& retired : T::kRetiredKeys) archive->Retire(retired);
+  }
+  archive->Finish();
+}
 
 /// The alternative of variant `V` at `index`, default-constructed.
 template <typename V, std::size_t... I>
@@ -249,8 +273,7 @@ bool ReadChoice(const ConfigNode& node, const std::string& key, std::variant<A..
         ReadArchive archive(node, key, context);
         std::string kind = kinds[index];
         archive.Visit(NameValue<std::string>{kKindKey, &kind});
-        alternative.Serialize(&archive);
-        archive.Finish();
+        ReadFields(&archive, &alternative);
       },
       *value);
   if (context->problems->size() == problems_before) return true;
@@ -274,8 +297,7 @@ bool ReadValue(const ConfigNode& node, const std::string& key, T* value,
     }
     const std::size_t problems_before = context->problems->size();
     ReadArchive archive(node, key, context);
-    value->Serialize(&archive);
-    archive.Finish();
+    ReadFields(&archive, value);
     return context->problems->size() == problems_before;
   } else if constexpr (IsVariant<T>::value) {
     // A tagged choice: a map (null keeps the current alternative as it is).

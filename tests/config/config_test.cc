@@ -572,6 +572,16 @@ TEST(ConfigChoiceTest, KeyOfAnotherKindNamesFileLineKeyAndBothKinds) {
                        "(no kind given here: the base's or the default)"));
 }
 
+TEST(ConfigChoiceTest, RetiredKeysNameTheKeyThatReplacedThem) {
+  // At the top level and inside a choice's alternative, with the note.
+  const std::string what = ChoiceErrorOf("line_slope: 2\nmodel:\n  gradient: 3\n");
+  EXPECT_TRUE(Contains(what, "x.yaml:1:1: line_slope: a retired key, now model.slope "
+                             "(with model.kind: line)"))
+      << what;
+  EXPECT_TRUE(Contains(what + "\n", "x.yaml:3:3: model.gradient: a retired key, now model.slope\n"))
+      << what;
+}
+
 TEST(ConfigChoiceTest, BadKindValuesAndValidationProblemsPointAtTheirText) {
   EXPECT_EQ(ChoiceErrorOf("model:\n  kind: square\n  slope: 2\n"),
             "x.yaml:2:9: model.kind: expected line or circle (got square)");

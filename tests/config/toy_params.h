@@ -102,6 +102,8 @@ struct ToyParams {
 /// One alternative of a tagged choice (`kind: line`).
 struct LineToyModel {
   static constexpr const char* kKind = "line";
+  /// Keys this struct no longer reads.
+  static constexpr RetiredKey kRetiredKeys[] = {{"gradient", "slope", ""}};
   /// Slope, >= 0.
   double slope = 1.0;
   InnerToyParams inner;
@@ -154,6 +156,9 @@ struct CircleToyModel {
 /// A struct with a tagged choice (`model: {kind: line | circle, ...}`).
 struct ChoiceToyParams {
   double rate_hz = 10.0;
+  /// Keys this struct no longer reads.
+  static constexpr RetiredKey kRetiredKeys[] = {
+      {"line_slope", "model.slope", "with model.kind: line"}};
   std::variant<LineToyModel, CircleToyModel> model;
 
   template <typename Archive>
