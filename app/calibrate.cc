@@ -9,6 +9,7 @@
 #include <limits>
 #include <stdexcept>
 #include <string>
+#include <variant>
 
 #include <Eigen/Dense>
 
@@ -101,29 +102,39 @@ Eigen::VectorXd FitVariance(const Eigen::MatrixXd& X, const Eigen::VectorXd& y) 
   return best;
 }
 
-double Variance(const slam::EkfParams& p, const WindowSums& w, int component) {
-  const slam::OdometryNoiseParams& n = p.odometry_noise;
+// The odometry process model of `p`; when `p`'s is of kind command (its
+// odometry noise unused), the built-in one with `p`'s integration.
+slam::OdometryProcessModel OdometryModelOf(const slam::EkfParams& p) {
+  if (const auto* m = std::get_if<slam::OdometryProcessModel>(&p.process_model)) return *m;
+  slam::OdometryProcessModel m;
+  m.integration = slam::IntegrationOf(p.process_model);
+  return m;
+}
+
+double Variance(const slam::OdometryProcessModel& m, const WindowSums& w, int component) {
+  const slam::OdometryNoiseParams& n = m.noise;
   auto sq = [](double v) { return v * v; };
   if (component == 0) {
-    return sq(n.distance_noise_std_m) * w.records + sq(n.distance_noise_std_m_per_sqrt_m) * w.distance +
-           sq(n.distance_noise_std_m_per_sqrt_rad) * w.turn;
+    return sq(n.distance_std_m) * w.records + sq(n.distance_std_m_per_sqrt_m) * w.distance +
+           sq(n.distance_std_m_per_sqrt_rad) * w.turn;
   }
   if (component == 1) {
-    return sq(n.heading_noise_std_rad) * w.records + sq(n.heading_noise_std_rad_per_sqrt_m) * w.distance +
-           sq(n.heading_noise_std_rad_per_sqrt_rad) * w.turn;
+    return sq(n.heading_std_rad) * w.records + sq(n.heading_std_rad_per_sqrt_m) * w.distance +
+           sq(n.heading_std_rad_per_sqrt_rad) * w.turn;
   }
-  return sq(p.lateral_slip_std_m_per_rad) * w.turn2 + sq(p.lateral_slip_std_m_per_sqrt_m) * w.distance;
+  return sq(m.lateral.slip_std_m_per_rad) * w.turn2 + sq(m.lateral.slip_std_m_per_sqrt_m) * w.distance;
 }
 
 WindowCheck Check(const std::vector<std::vector<RecordError>>& runs, const slam::EkfParams& p,
                   int size) {
   WindowCheck check;
   check.window_records = size;
+  const slam::OdometryProcessModel model = OdometryModelOf(p);
   std::array<double, 3> sums{0.0, 0.0, 0.0};
   for (const WindowSums& w : Windows(runs, size)) {
     const std::array<double, 3> e{w.e_d, w.e_th, w.e_lateral};
     for (int c = 0; c < 3; ++c) {
-      const double variance = Variance(p, w, c);
+      const double variance = Variance(model, w, c);
       sums[c] += variance > 0.0 ? e[c] * e[c] / variance : (e[c] == 0.0 ? 0.0 : kInfinity);
     }
     ++check.windows;
@@ -143,6 +154,7 @@ RunSystematics FitSystematics(const std::string& name, const std::vector<RecordE
   result.name = name;
   result.records = static_cast<int>(records.size());
   const double b = p.axle_track_m * p.axle_track_m / 4.0;
+  const slam::OdometryProcessModel model = OdometryModelOf(p);
   Eigen::Matrix3d normal = Eigen::Matrix3d::Zero();
   Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
   for (const RecordError& r : records) {
@@ -150,8 +162,8 @@ RunSystematics FitSystematics(const std::string& name, const std::vector<RecordE
     w.records = 1.0;
     w.distance = std::abs(r.d);
     w.turn = std::abs(r.dth);
-    const double wd = 1.0 / std::max(Variance(p, w, 0), 1e-12);
-    const double wth = 1.0 / std::max(Variance(p, w, 1), 1e-12);
+    const double wd = 1.0 / std::max(Variance(model, w, 0), 1e-12);
+    const double wth = 1.0 / std::max(Variance(model, w, 1), 1e-12);
     const Eigen::Vector3d jd(r.d, 0.0, b * r.dth);
     const Eigen::Vector3d jth(0.0, r.dth, r.d);
     normal += wd * jd * jd.transpose() + wth * jth * jth.transpose();
@@ -191,6 +203,7 @@ Calibration Calibrate(const std::vector<RunMotion>& runs, const slam::EkfParams&
                                 std::to_string(window_records) + ")");
   }
   const double a = model.control_point_offset_m;
+  const slam::OdometryNoiseParams& given_noise = OdometryModelOf(model).noise;
   // Step 1: each record's errors, the lateral one with no skid, and the
   // skid's regressor d dth / dt.
   std::vector<std::vector<RecordError>> errors(runs.size());
@@ -209,9 +222,9 @@ Calibration Calibrate(const std::vector<RunMotion>& runs, const slam::EkfParams&
       }
       if (dt == 0.0) continue;
       const slam::MotionInput odometry =
-          slam::OdometryInput(run.X_OR[i - 1], run.X_OR[i], a, model.odometry_noise);
+          slam::OdometryInput(run.X_OR[i - 1], run.X_OR[i], a, given_noise);
       const slam::MotionInput truth =
-          slam::OdometryInput(run.X_WR_true[i - 1], run.X_WR_true[i], a, model.odometry_noise);
+          slam::OdometryInput(run.X_WR_true[i - 1], run.X_WR_true[i], a, given_noise);
       const Pose2& X0 = run.X_WR_true[i - 1];
       const Eigen::Vector3d predicted =
           slam::PredictPose(Eigen::Vector3d(X0.x, X0.y, X0.theta), truth.increment, a);
@@ -234,11 +247,12 @@ Calibration Calibrate(const std::vector<RunMotion>& runs, const slam::EkfParams&
   }
   Calibration result;
   result.fitted = model;
-  result.fitted.lateral_skid_s = skid_den > 0.0 ? Round3(std::max(0.0, skid_num / skid_den)) : 0.0;
+  slam::OdometryProcessModel fitted = OdometryModelOf(model);
+  fitted.lateral.skid_s = skid_den > 0.0 ? Round3(std::max(0.0, skid_num / skid_den)) : 0.0;
   // Step 2: the skid and each run's systematic part removed.
   for (std::size_t r = 0; r < runs.size(); ++r) {
     for (std::size_t i = 0; i < errors[r].size(); ++i) {
-      errors[r][i].e_lateral += result.fitted.lateral_skid_s * skid_regressor[r][i];
+      errors[r][i].e_lateral += fitted.lateral.skid_s * skid_regressor[r][i];
     }
     const RunSystematics s = FitSystematics(runs[r].name, errors[r], model);
     const double b = model.axle_track_m * model.axle_track_m / 4.0;
@@ -274,15 +288,16 @@ Calibration Calibrate(const std::vector<RunMotion>& runs, const slam::EkfParams&
   const Eigen::VectorXd cd = FitVariance(X3, yd);
   const Eigen::VectorXd cth = FitVariance(X3, yth);
   const Eigen::VectorXd clat = FitVariance(X2, ylat);
-  slam::OdometryNoiseParams& noise = result.fitted.odometry_noise;
-  noise.distance_noise_std_m = 0.0;
-  noise.distance_noise_std_m_per_sqrt_m = Round3(std::sqrt(cd(0)));
-  noise.distance_noise_std_m_per_sqrt_rad = Round3(std::sqrt(cd(1)));
-  noise.heading_noise_std_rad = 0.0;
-  noise.heading_noise_std_rad_per_sqrt_m = Round3(std::sqrt(cth(0)));
-  noise.heading_noise_std_rad_per_sqrt_rad = Round3(std::sqrt(cth(1)));
-  result.fitted.lateral_slip_std_m_per_sqrt_m = Round3(std::sqrt(clat(0)));
-  result.fitted.lateral_slip_std_m_per_rad = Round3(std::sqrt(clat(1)));
+  slam::OdometryNoiseParams& noise = fitted.noise;
+  noise.distance_std_m = 0.0;
+  noise.distance_std_m_per_sqrt_m = Round3(std::sqrt(cd(0)));
+  noise.distance_std_m_per_sqrt_rad = Round3(std::sqrt(cd(1)));
+  noise.heading_std_rad = 0.0;
+  noise.heading_std_rad_per_sqrt_m = Round3(std::sqrt(cth(0)));
+  noise.heading_std_rad_per_sqrt_rad = Round3(std::sqrt(cth(1)));
+  fitted.lateral.slip_std_m_per_sqrt_m = Round3(std::sqrt(clat(0)));
+  fitted.lateral.slip_std_m_per_rad = Round3(std::sqrt(clat(1)));
+  result.fitted.process_model = fitted;
   for (int size : {1, window_records, 5 * window_records}) {
     result.given_checks.push_back(Check(errors, model, size));
     result.fitted_checks.push_back(Check(errors, result.fitted, size));
@@ -337,8 +352,8 @@ RunMotion ReadRunMotion(const std::string& run_dir) {
 
 std::string CalibrationYaml(const Calibration& calibration, const std::string& base,
                             const std::string& header) {
-  const slam::EkfParams& p = calibration.fitted;
-  const slam::OdometryNoiseParams& n = p.odometry_noise;
+  const slam::OdometryProcessModel m = OdometryModelOf(calibration.fitted);
+  const slam::OdometryNoiseParams& n = m.noise;
   std::string yaml;
   for (std::size_t start = 0; start < header.size();) {
     const std::size_t end = header.find('\n', start);
@@ -347,19 +362,21 @@ std::string CalibrationYaml(const Calibration& calibration, const std::string& b
     start = end + 1;
   }
   if (!base.empty()) yaml += "base: " + base + "\n";
-  yaml += "slam:\n  ekf:\n    odometry_noise:\n";
-  yaml += "      distance_noise_std_m: " + Text3(n.distance_noise_std_m) + "\n";
-  yaml += "      distance_noise_std_m_per_sqrt_m: " + Text3(n.distance_noise_std_m_per_sqrt_m) + "\n";
-  yaml += "      distance_noise_std_m_per_sqrt_rad: " + Text3(n.distance_noise_std_m_per_sqrt_rad) +
-          "\n";
-  yaml += "      heading_noise_std_rad: " + Text3(n.heading_noise_std_rad) + "\n";
-  yaml += "      heading_noise_std_rad_per_sqrt_m: " + Text3(n.heading_noise_std_rad_per_sqrt_m) +
-          "\n";
-  yaml += "      heading_noise_std_rad_per_sqrt_rad: " +
-          Text3(n.heading_noise_std_rad_per_sqrt_rad) + "\n";
-  yaml += "    lateral_slip_std_m_per_rad: " + Text3(p.lateral_slip_std_m_per_rad) + "\n";
-  yaml += "    lateral_slip_std_m_per_sqrt_m: " + Text3(p.lateral_slip_std_m_per_sqrt_m) + "\n";
-  yaml += "    lateral_skid_s: " + Text3(p.lateral_skid_s) + "\n";
+  // The whole process model: a base of kind command would otherwise give
+  // the odometry kind's built-in integration.
+  yaml += "slam:\n  ekf:\n    process_model:\n      kind: odometry\n";
+  yaml += "      integration: " + m.integration + "\n";
+  yaml += "      noise:\n";
+  yaml += "        distance_std_m: " + Text3(n.distance_std_m) + "\n";
+  yaml += "        distance_std_m_per_sqrt_m: " + Text3(n.distance_std_m_per_sqrt_m) + "\n";
+  yaml += "        distance_std_m_per_sqrt_rad: " + Text3(n.distance_std_m_per_sqrt_rad) + "\n";
+  yaml += "        heading_std_rad: " + Text3(n.heading_std_rad) + "\n";
+  yaml += "        heading_std_rad_per_sqrt_m: " + Text3(n.heading_std_rad_per_sqrt_m) + "\n";
+  yaml += "        heading_std_rad_per_sqrt_rad: " + Text3(n.heading_std_rad_per_sqrt_rad) + "\n";
+  yaml += "      lateral:\n";
+  yaml += "        slip_std_m_per_rad: " + Text3(m.lateral.slip_std_m_per_rad) + "\n";
+  yaml += "        slip_std_m_per_sqrt_m: " + Text3(m.lateral.slip_std_m_per_sqrt_m) + "\n";
+  yaml += "        skid_s: " + Text3(m.lateral.skid_s) + "\n";
   return yaml;
 }
 
@@ -373,23 +390,23 @@ std::string CalibrationReport(const Calibration& calibration, const slam::EkfPar
   std::snprintf(line, sizeof line, "%zu runs, %d records\n  %-52s %10s %10s\n",
                 calibration.runs.size(), calibration.records, "slam.ekf key", "given", "fitted");
   text += line;
-  const slam::OdometryNoiseParams& g = given.odometry_noise;
-  const slam::OdometryNoiseParams& f = calibration.fitted.odometry_noise;
-  add("odometry_noise.distance_noise_std_m", g.distance_noise_std_m, f.distance_noise_std_m);
-  add("odometry_noise.distance_noise_std_m_per_sqrt_m", g.distance_noise_std_m_per_sqrt_m,
-      f.distance_noise_std_m_per_sqrt_m);
-  add("odometry_noise.distance_noise_std_m_per_sqrt_rad", g.distance_noise_std_m_per_sqrt_rad,
-      f.distance_noise_std_m_per_sqrt_rad);
-  add("odometry_noise.heading_noise_std_rad", g.heading_noise_std_rad, f.heading_noise_std_rad);
-  add("odometry_noise.heading_noise_std_rad_per_sqrt_m", g.heading_noise_std_rad_per_sqrt_m,
-      f.heading_noise_std_rad_per_sqrt_m);
-  add("odometry_noise.heading_noise_std_rad_per_sqrt_rad", g.heading_noise_std_rad_per_sqrt_rad,
-      f.heading_noise_std_rad_per_sqrt_rad);
-  add("lateral_slip_std_m_per_rad", given.lateral_slip_std_m_per_rad,
-      calibration.fitted.lateral_slip_std_m_per_rad);
-  add("lateral_slip_std_m_per_sqrt_m", given.lateral_slip_std_m_per_sqrt_m,
-      calibration.fitted.lateral_slip_std_m_per_sqrt_m);
-  add("lateral_skid_s", given.lateral_skid_s, calibration.fitted.lateral_skid_s);
+  const slam::OdometryProcessModel g = OdometryModelOf(given);
+  const slam::OdometryProcessModel f = OdometryModelOf(calibration.fitted);
+  add("process_model.noise.distance_std_m", g.noise.distance_std_m, f.noise.distance_std_m);
+  add("process_model.noise.distance_std_m_per_sqrt_m", g.noise.distance_std_m_per_sqrt_m,
+      f.noise.distance_std_m_per_sqrt_m);
+  add("process_model.noise.distance_std_m_per_sqrt_rad", g.noise.distance_std_m_per_sqrt_rad,
+      f.noise.distance_std_m_per_sqrt_rad);
+  add("process_model.noise.heading_std_rad", g.noise.heading_std_rad, f.noise.heading_std_rad);
+  add("process_model.noise.heading_std_rad_per_sqrt_m", g.noise.heading_std_rad_per_sqrt_m,
+      f.noise.heading_std_rad_per_sqrt_m);
+  add("process_model.noise.heading_std_rad_per_sqrt_rad", g.noise.heading_std_rad_per_sqrt_rad,
+      f.noise.heading_std_rad_per_sqrt_rad);
+  add("process_model.lateral.slip_std_m_per_rad", g.lateral.slip_std_m_per_rad,
+      f.lateral.slip_std_m_per_rad);
+  add("process_model.lateral.slip_std_m_per_sqrt_m", g.lateral.slip_std_m_per_sqrt_m,
+      f.lateral.slip_std_m_per_sqrt_m);
+  add("process_model.lateral.skid_s", g.lateral.skid_s, f.lateral.skid_s);
   text += "\nmean (error / sigma)^2 over windows (1 when the model is right):\n";
   std::snprintf(line, sizeof line, "  %8s %8s   %-26s   %-26s\n", "records", "windows",
                 "given: distance heading lat", "fitted: distance heading lat");

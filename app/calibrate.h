@@ -43,9 +43,9 @@ struct WindowCheck {
 };
 
 struct Calibration {
-  /// The fitted noise: odometry_noise, lateral_skid_s,
-  /// lateral_slip_std_m_per_rad and lateral_slip_std_m_per_sqrt_m; the
-  /// other fields are those of the model given.
+  /// The model given with its process model replaced by the fitted one, of
+  /// kind odometry: its noise and lateral motion fitted, its integration
+  /// the given one's.
   slam::EkfParams fitted;
   std::vector<RunSystematics> runs;
   /// The checks of the model given and of the fitted one, for windows of
@@ -56,14 +56,16 @@ struct Calibration {
 };
 
 /// Fits the odometry noise of `model` (its offset a and track B are used as
-/// they are) to the runs' records, in three steps:
+/// they are; its process model is the given one when of kind odometry, else
+/// the built-in odometry model) to the runs' records, in three steps:
 ///   1. each record's input error: the increments (d, dth) that
 ///      slam::OdometryInput gives for the true motion less those of the
 ///      odometry, and the true motion's lateral offset across the mid-arc
 ///      heading that slam::PredictPose leaves;
 ///   2. per run, the systematic part, least squares: d -> q_d d + k B^2/4
 ///      dth, dth -> q_th dth + k d (what self-calibration estimates), and
-///      the skid (lateral_skid_s) pooled over the runs; both removed;
+///      the skid (process_model.lateral.skid_s) pooled over the runs; both
+///      removed;
 ///   3. the variances of OdometryNoiseParams (per metre and per radian; the
 ///      floors per record are set to 0) and the lateral slip fitted,
 ///      non-negative, to the remaining errors summed over windows of
@@ -85,9 +87,10 @@ std::vector<std::string> RunDirectories(const std::vector<std::string>& paths);
 /// imported log).
 RunMotion ReadRunMotion(const std::string& run_dir);
 
-/// The YAML of a config that sets the fitted keys of `calibration`, on top
-/// of `base` (a path written as given; empty: no base), with a header
-/// naming the runs.
+/// The YAML of a config that sets the fitted process model of
+/// `calibration` whole (`slam.ekf.process_model`, kind odometry: its
+/// integration, noise and lateral motion), on top of `base` (a path written
+/// as given; empty: no base), with a header naming the runs.
 std::string CalibrationYaml(const Calibration& calibration, const std::string& base,
                             const std::string& header);
 

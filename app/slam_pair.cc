@@ -85,7 +85,7 @@ void SlamPair::Step(const SensorRecord& record) {
     } else {
       // Busy: the scan is lost; with command input the record's command
       // waits for the next prediction.
-      if (params_.ekf.input != "odometry") {
+      if (!slam::PredictsFromOdometry(params_.ekf.process_model)) {
         SensorRecord motion;
         motion.t_s = record.t_s;
         motion.dt_s = record.dt_s;
@@ -117,7 +117,9 @@ slam::StepReport SlamPair::CatchUpAndStep(Filter* f, int step, const SensorRecor
   for (const SensorRecord& skipped : f->skipped_records) f->filter.Step(skipped, nullptr);
   f->skipped_records.clear();
   // (The first record, step 0, has no earlier one: it predicts nothing.)
-  if (params_.ekf.input != "odometry" || step == 0) return f->filter.Step(record, features);
+  if (!slam::PredictsFromOdometry(params_.ekf.process_model) || step == 0) {
+    return f->filter.Step(record, features);
+  }
   // Odometry input: the filter takes the increment from the odometry pose of
   // its last processed record; dt is the whole time since that record.
   SensorRecord since_last = record;

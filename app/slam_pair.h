@@ -52,9 +52,9 @@ class SlamPair {
   /// with an earlier record skips this one (processed(i) is false after the
   /// call): its estimate and map stay those of its last processed record.
   /// A filter that is free predicts over every step since its last processed
-  /// record, then processes this one: with `input: command`, one
-  /// prediction per skipped record with that record's own command and dt;
-  /// with `input: odometry`, one prediction from the odometry pose of its
+  /// record, then processes this one: with a process model of kind command,
+  /// one prediction per skipped record with that record's own command and dt;
+  /// of kind odometry, one prediction from the odometry pose of its
   /// last processed record to this one's, dt the time between them.
   void Step(const SensorRecord& record);
 

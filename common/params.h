@@ -23,6 +23,19 @@ struct NameValue {
 /// `a->Visit(MJSLAM_NVP(rate_hz));` inside a Params' `Serialize`.
 #define MJSLAM_NVP(field) ::mjslam::NameValue<decltype(field)>{#field, &(field)}
 
+/// A key that a Params struct no longer reads, and the key (relative to the
+/// same struct) that took its place. A Params lists its own in
+/// `static constexpr RetiredKey kRetiredKeys[]`; the config reader reports
+/// such a key where it is given, with the new one, instead of "unknown key".
+struct RetiredKey {
+  /// The old key.
+  const char* key;
+  /// The key that replaced it.
+  const char* replacement;
+  /// How the value moves beyond the new key's name, or "".
+  const char* note;
+};
+
 /// One thing wrong with a parameter value: the dotted key (relative to the
 /// struct that validated it), the value as text, and what was expected.
 struct ParamProblem {

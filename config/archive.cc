@@ -78,7 +78,49 @@ std::size_t EditDistance(const std::string& a, const std::string& b) {
   return d[a.size()][b.size()];
 }
 
+// Whether the dotted `path` ("noise.v_std_mps") names an entry of `tree`'s
+// nested maps.
+bool HasKeyPath(const ConfigNode& tree, const std::string& path) {
+  const ConfigNode* node = &tree;
+  std::size_t start = 0;
+  for (;;) {
+    const std::size_t dot = path.find('.', start);
+    const std::string part = path.substr(start, dot == std::string::npos ? dot : dot - start);
+    const auto entry = std::find_if(node->entries.begin(), node->entries.end(),
+                                    [&part](const ConfigEntry& e) { return e.key == part; });
+    if (entry == node->entries.end()) return false;
+    if (dot == std::string::npos) return true;
+    node = &entry->value;
+    start = dot + 1;
+  }
+}
+
 }  // namespace
+
+void NameKeysOfOtherKinds(const std::string& key, const std::vector<std::string>& kinds,
+                          std::size_t chosen, bool kind_given,
+                          const std::vector<ConfigNode>& trees, std::size_t first,
+                          ReadContext* context) {
+  const std::string prefix = key + ".";
+  const std::string unknown = "unknown key";
+  for (std::size_t i = first; i < context->problems->size(); ++i) {
+    ConfigProblem& problem = (*context->problems)[i];
+    if (problem.key.compare(0, prefix.size(), prefix) != 0 ||
+        problem.message.compare(0, unknown.size(), unknown) != 0) {
+      continue;
+    }
+    const std::string path = problem.key.substr(prefix.size());
+    for (std::size_t j = 0; j < kinds.size(); ++j) {
+      if (j == chosen || !HasKeyPath(trees[j], path)) continue;
+      // Keep the list of the keys known here, drop a "did you mean".
+      const std::size_t list = problem.message.find(" (");
+      problem.message = "a key of kind '" + kinds[j] + "', not of kind '" + kinds[chosen] + "'" +
+                        (kind_given ? "" : " (no kind given here: the base's or the default)") +
+                        (list == std::string::npos ? "" : problem.message.substr(list));
+      break;
+    }
+  }
+}
 
 void MarkTable::Record(const std::string& key, const SourceMark& mark, bool is_struct) {
   marks_[key] = Recorded{mark, is_struct};
@@ -221,6 +263,17 @@ void ReadArchive::Finish() {
 
     // A key that no field visited: list the known ones, suggest the closest.
     if (std::find(known_.begin(), known_.end(), entry.key) != known_.end()) continue;
+
+    // A key the struct once read: name the key that replaced it.
+    const auto retired = std::find_if(retired_.begin(), retired_.end(),
+                                      [&](const RetiredKey& r) { return entry.key == r.key; });
+    if (retired != retired_.end()) {
+      const std::string note = retired->note;
+      context_->Problem(entry.key_mark, key,
+                        "a retired key, now " + JoinKey(prefix_, retired->replacement) +
+                            (note.empty() ? "" : " (" + note + ")"));
+      continue;
+    }
     std::string message = "unknown key";
     std::size_t best_distance = std::numeric_limits<std::size_t>::max();
     const std::string* best = nullptr;

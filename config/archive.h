@@ -5,6 +5,7 @@
 // the tree of every field. Header-only templates, free of yaml-cpp; the
 // non-template parts live in config/archive.cc. Users call config/config.h.
 
+#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -12,6 +13,7 @@
 #include <string>
 #include <type_traits>
 #include <utility>
+#include <variant>
 #include <vector>
 
 #include "common/params.h"
@@ -44,6 +46,24 @@ template <typename T>
 struct IsArray : std::false_type {};
 template <typename U, std::size_t N>
 struct IsArray<std::array<U, N>> : std::true_type {};
+
+/// Whether T lists keys it no longer reads (`static constexpr RetiredKey
+/// kRetiredKeys[]`).
+template <typename T, typename = void>
+struct HasRetiredKeys : std::false_type {};
+template <typename T>
+struct HasRetiredKeys<T, std::void_t<decltype(T::kRetiredKeys)>> : std::true_type {};
+
+/// A tagged choice: a `std::variant` of Params structs, each with
+/// `static constexpr const char* kKind`, the name its YAML map gives under
+/// `kind:` (Drake's variant by tag).
+template <typename T>
+struct IsVariant : std::false_type {};
+template <typename... A>
+struct IsVariant<std::variant<A...>> : std::true_type {};
+
+/// The key whose value picks a tagged choice's alternative.
+inline constexpr const char* kKindKey = "kind";
 
 /// Scalar field types read and written by ReadLeaf / WriteLeaf.
 template <typename T>
@@ -115,6 +135,8 @@ template <typename T>
 std::string Describe(bool plural) {
   if constexpr (HasSerialize<T>::value) {
     return plural ? "maps of keys" : "a map of keys";
+  } else if constexpr (IsVariant<T>::value) {
+    return plural ? "maps with a kind" : "a map with a kind";
   } else if constexpr (IsVector<T>::value) {
     return std::string(plural ? "sequences of " : "a sequence of ") +
            Describe<typename T::value_type>(true);
@@ -141,6 +163,9 @@ template <typename T>
 bool ReadValue(const ConfigNode& node, const std::string& key, T* value,
                ReadContext* context);
 
+template <typename T>
+ConfigNode WriteValue(const T& value);
+
 /// Visits the fields of a Params struct while reading one map node.
 class ReadArchive {
  public:
@@ -161,8 +186,13 @@ class ReadArchive {
     }
   }
 
-  /// After Serialize: reports duplicate keys and keys no field visited
-  /// (listing the known keys of this level).
+  /// Names a key the struct no longer reads: Finish reports it with its
+  /// replacement instead of as unknown.
+  void Retire(const RetiredKey& retired) { retired_.push_back(retired); }
+
+  /// After Serialize: reports duplicate keys, retired keys (with the key
+  /// that replaced each) and keys no field visited (listing the known keys
+  /// of this level).
   void Finish();
 
  private:
@@ -170,13 +200,93 @@ class ReadArchive {
   std::string prefix_;
   ReadContext* context_;
   std::vector<std::string> known_;
+  std::vector<RetiredKey> retired_;
 };
+
+/// Reads the fields of the Params `*params` from `archive`'s map, then
+/// reports that map's retired, duplicate and unknown keys.
+template <typename T>
+void ReadFields(ReadArchive* archive, T* params) {
+  params->Serialize(archive);
+  if constexpr (HasRetiredKeys<T>::value) {
+    for (const RetiredKey& retired : T::kRetiredKeys) archive->Retire(retired);
+  }
+  archive->Finish();
+}
+
+/// The alternative of variant `V` at `index`, default-constructed.
+template <typename V, std::size_t... I>
+V AlternativeAt(std::size_t index, std::index_sequence<I...>) {
+  V result;
+  ((I == index ? (void)result.template emplace<I>() : (void)0), ...);
+  return result;
+}
+
+/// Rewords the problems from `first` on that are unknown keys under the
+/// choice `key` and that the tree of another alternative (`trees[j]`, kind
+/// `kinds[j]`) has: "a key of kind 'command', not of kind 'odometry'".
+/// `kind_given`: whether the map names its kind (else the kind is the one
+/// already there: the default's or a base's).
+void NameKeysOfOtherKinds(const std::string& key, const std::vector<std::string>& kinds,
+                          std::size_t chosen, bool kind_given,
+                          const std::vector<ConfigNode>& trees, std::size_t first,
+                          ReadContext* context);
+
+/// Reads the map `node` of a tagged choice: its `kind` picks the alternative
+/// (absent: the current one stays), which is then read from the map's other
+/// keys; a key only another kind has is a problem naming both kinds.
+template <typename... A>
+bool ReadChoice(const ConfigNode& node, const std::string& key, std::variant<A...>* value,
+                ReadContext* context) {
+  using Kind = ConfigNode::Kind;
+  const std::vector<std::string> kinds = {A::kKind...};
+
+  // The kind: the map's first `kind` entry, else the current alternative's.
+  std::size_t index = value->index();
+  bool kind_given = false;
+  for (const ConfigEntry& entry : node.entries) {
+    if (entry.key != kKindKey) continue;
+    const auto named = entry.value.kind == Kind::kScalar
+                           ? std::find(kinds.begin(), kinds.end(), entry.value.scalar)
+                           : kinds.end();
+    if (named == kinds.end()) {
+      std::string names;
+      for (std::size_t k = 0; k < kinds.size(); ++k) {
+        names += (k == 0 ? "" : k + 1 == kinds.size() ? " or " : ", ") + kinds[k];
+      }
+      context->Problem(entry.value.mark, JoinKey(key, kKindKey),
+                       "expected " + names + " (got " + NodeText(entry.value) + ")");
+      return false;
+    }
+    index = static_cast<std::size_t>(named - kinds.begin());
+    kind_given = true;
+    break;
+  }
+  if (index != value->index()) {
+    *value = AlternativeAt<std::variant<A...>>(index, std::index_sequence_for<A...>{});
+  }
+
+  // The alternative's keys, `kind` among them.
+  const std::size_t problems_before = context->problems->size();
+  std::visit(
+      [&](auto& alternative) {
+        ReadArchive archive(node, key, context);
+        std::string kind = kinds[index];
+        archive.Visit(NameValue<std::string>{kKindKey, &kind});
+        ReadFields(&archive, &alternative);
+      },
+      *value);
+  if (context->problems->size() == problems_before) return true;
+  const std::vector<ConfigNode> trees = {WriteValue(A{})...};
+  NameKeysOfOtherKinds(key, kinds, index, kind_given, trees, problems_before, context);
+  return false;
+}
 
 template <typename T>
 bool ReadValue(const ConfigNode& node, const std::string& key, T* value,
                ReadContext* context) {
   using Kind = ConfigNode::Kind;
-  context->marks->Record(key, node.mark, HasSerialize<T>::value);
+  context->marks->Record(key, node.mark, HasSerialize<T>::value || IsVariant<T>::value);
   if constexpr (HasSerialize<T>::value) {
     // Nested Params: a map (null, e.g. `laser:` alone, keeps every default).
     if (node.kind == Kind::kNull) return true;
@@ -187,9 +297,17 @@ bool ReadValue(const ConfigNode& node, const std::string& key, T* value,
     }
     const std::size_t problems_before = context->problems->size();
     ReadArchive archive(node, key, context);
-    value->Serialize(&archive);
-    archive.Finish();
+    ReadFields(&archive, value);
     return context->problems->size() == problems_before;
+  } else if constexpr (IsVariant<T>::value) {
+    // A tagged choice: a map (null keeps the current alternative as it is).
+    if (node.kind == Kind::kNull) return true;
+    if (node.kind != Kind::kMap) {
+      context->Problem(node.mark, key,
+                       "expected " + Describe<T>(false) + " (got " + NodeText(node) + ")");
+      return false;
+    }
+    return ReadChoice(node, key, value, context);
   } else if constexpr (IsVector<T>::value || IsArray<T>::value) {
     // Sequences: read every item into a copy, assign only when all are good.
     bool length_ok = node.kind == Kind::kSequence;
@@ -228,9 +346,6 @@ bool ReadValue(const ConfigNode& node, const std::string& key, T* value,
   }
 }
 
-template <typename T>
-ConfigNode WriteValue(const T& value);
-
 /// Visits the fields of a Params struct while building one map node.
 class WriteArchive {
  public:
@@ -246,7 +361,8 @@ class WriteArchive {
   ConfigNode* map_;
 };
 
-/// The tree of `value`: a map for Params structs, sequences for vectors and
+/// The tree of `value`: a map for Params structs (for a tagged choice, its
+/// `kind` first, then the alternative's fields), sequences for vectors and
 /// arrays, scalars for leaves.
 template <typename T>
 ConfigNode WriteValue(const T& value) {
@@ -257,6 +373,16 @@ ConfigNode WriteValue(const T& value) {
     WriteArchive archive(&node);
     copy.Serialize(&archive);
     return node;
+  } else if constexpr (IsVariant<T>::value) {
+    return std::visit(
+        [](const auto& alternative) {
+          ConfigNode node = WriteValue(alternative);
+          const std::string kind = std::decay_t<decltype(alternative)>::kKind;
+          node.entries.insert(node.entries.begin(),
+                              ConfigEntry{kKindKey, SourceMark{}, WriteLeaf(kind)});
+          return node;
+        },
+        value);
   } else if constexpr (IsVector<T>::value || IsArray<T>::value) {
     ConfigNode node = SequenceNode();
     for (const auto& item : value) node.items.push_back(WriteValue(item));

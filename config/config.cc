@@ -53,7 +53,7 @@ void Remark(ConfigNode* node, const SourceMark& mark) {
 // The scalar of a map's "kind" entry, or "" when it has none.
 std::string KindOf(const ConfigNode& map) {
   for (const ConfigEntry& entry : map.entries) {
-    if (entry.key == "kind" && entry.value.kind == Kind::kScalar) return entry.value.scalar;
+    if (entry.key == kKindKey && entry.value.kind == Kind::kScalar) return entry.value.scalar;
   }
   return {};
 }
@@ -238,6 +238,12 @@ void ApplyOverrides(const std::vector<std::string>& overrides, ConfigNode* root,
         entry->value = MapNode(mark);
       }
       node = &entry->value;
+    }
+    // A new kind for a choice (`--set a.kind=two`) replaces its map, as
+    // `--set a={kind: two}` does: the keys of the old kind would not apply.
+    if (parts.size() > 1 && parts.back() == kKindKey && value.kind == Kind::kScalar &&
+        !KindOf(*node).empty() && KindOf(*node) != value.scalar) {
+      node->entries.clear();
     }
     if (ConfigEntry* entry = FindEntry(node, parts.back())) {
       Merge(&entry->value, value);

@@ -90,8 +90,7 @@ T LoadConfigString(const std::string& yaml_text, const std::string& source_name,
   internal::MarkTable marks;
   internal::ReadContext context{&problems, &marks};
   internal::ReadArchive archive(root, "", &context);
-  params.Serialize(&archive);
-  archive.Finish();
+  internal::ReadFields(&archive, &params);
 
   // Range checks, pointed at the text that set each value.
   if constexpr (internal::HasValidate<T>::value) {

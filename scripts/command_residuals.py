@@ -5,7 +5,8 @@ change of the turn command (docs/results.md, "The maze map loss").
 
     scripts/command_residuals.py RUN_DIR [W_STD W_FRACTION CHANGE_FRACTION]
 
-The defaults are slam.ekf.command_noise's (0.03 rad/s, 0.1, 0.5). Reads
+The defaults are the built-in slam.ekf.process_model.noise of kind command
+(w_std_radps 0.03, w_fraction 0.1, change_fraction 0.5). Reads
 RUN_DIR/trajectory.csv (t, true_th, cmd_w; the command of row i is held from
 t_i to t_(i+1)) with python/mjslam. Prints, per period since the change, the
 steps and those beyond 3 and 4 sigma, then each step beyond 3 sigma. Debian's

@@ -29,8 +29,8 @@ import mjslam  # noqa: E402
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 LOGS = {"intel": "intel-corrected.log.gz", "fr079": "freiburg-079-corrected.log.gz"}
-ODOMETRY_KEYS = ["distance_noise_std_m", "distance_noise_std_m_per_sqrt_m", "heading_noise_std_rad",
-                 "heading_noise_std_rad_per_sqrt_m", "heading_noise_std_rad_per_sqrt_rad"]
+ODOMETRY_KEYS = ["distance_std_m", "distance_std_m_per_sqrt_m", "heading_std_rad",
+                 "heading_std_rad_per_sqrt_m", "heading_std_rad_per_sqrt_rad"]
 # configs/real.yaml's odometry noise, scaled by the candidates below.
 REAL_ODOMETRY = [0.005, 0.06, 0.005, 0.075, 0.045]
 SCALES = [0.5, 1.0, 2.0]
@@ -40,7 +40,8 @@ LAGS = ["1", "10", "100"]
 
 def settings():
     for scale, floor in itertools.product(SCALES, FLOORS):
-        sets = [f"slam.ekf.odometry_noise.{k}={v * scale:g}" for k, v in zip(ODOMETRY_KEYS, REAL_ODOMETRY)]
+        sets = [f"slam.ekf.process_model.noise.{k}={v * scale:g}"
+                for k, v in zip(ODOMETRY_KEYS, REAL_ODOMETRY)]
         sets.append(f"slam.features.line_rho_floor_std_m={floor:g}")
         yield f"odometry noise x{scale:g}, line floor {floor:g} m", sets
 

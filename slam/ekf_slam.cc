@@ -4,6 +4,7 @@
 #include <limits>
 #include <string>
 #include <utility>
+#include <variant>
 
 #include "common/angles.h"
 #include "common/params.h"
@@ -71,7 +72,7 @@ EkfSlam::EkfSlam(const EkfParams& params, CorrectionMode mode, const Pose2& X_WR
                  const Pose2& X_RS, Rng rng)
     : params_(Validated(params)),
       mode_(mode),
-      integration_(MotionIntegrationFromName(params.motion_integration)),
+      integration_(MotionIntegrationFromName(IntegrationOf(params.process_model))),
       policy_(SelectionPolicyFromName(params.selection_policy)),
       rng_(std::move(rng)),
       state_(Eigen::Vector3d(X_WR0.x, X_WR0.y, X_WR0.theta),
@@ -215,8 +216,9 @@ MotionInput EkfSlam::CheckedMotionInput(const SensorRecord& record) const {
     throw SlamInputError("EkfSlam::Step: record.dt_s: expected a finite value >= 0 (got " +
                          ValueText(record.dt_s) + ")");
   }
+  // The input and its noise, by the process model's kind.
   MotionInput input;
-  if (params_.input == "odometry") {
+  if (const auto* odometry = std::get_if<OdometryProcessModel>(&params_.process_model)) {
     if (!IsFinite(record.X_OR)) {
       throw SlamInputError("EkfSlam::Step: record.X_OR: expected a finite pose (got " +
                            PoseText(record.X_OR) + ")");
@@ -224,17 +226,20 @@ MotionInput EkfSlam::CheckedMotionInput(const SensorRecord& record) const {
     // The first record is the reference of the odometry increments.
     const Pose2& X_OR_previous = has_odometry_ ? X_OR_previous_ : record.X_OR;
     input = OdometryInput(X_OR_previous, record.X_OR, params_.control_point_offset_m,
-                          params_.odometry_noise);
+                          odometry->noise);
   } else {
+    const CommandProcessModel& command = std::get<CommandProcessModel>(params_.process_model);
     RequireFinite(record.command.v_mps, "record.command.v_mps");
     RequireFinite(record.command.w_radps, "record.command.w_radps");
-    input = CommandInput(record.command, record.dt_s, params_.command_noise, previous_command_);
+    input = CommandInput(record.command, record.dt_s, command.noise, previous_command_);
   }
-  const double turn_slip_std = params_.lateral_slip_std_m_per_rad * std::abs(input.increment.y());
-  const double roll_slip_std = params_.lateral_slip_std_m_per_sqrt_m;
+  // The sideways motion either kind adds.
+  const LateralMotionParams& lateral = LateralOf(params_.process_model);
+  const double turn_slip_std = lateral.slip_std_m_per_rad * std::abs(input.increment.y());
+  const double roll_slip_std = lateral.slip_std_m_per_sqrt_m;
   input.lateral_variance_m2 =
       turn_slip_std * turn_slip_std + roll_slip_std * roll_slip_std * std::abs(input.increment.x());
-  if (record.dt_s > 0.0) input.skid_per_m_rad = params_.lateral_skid_s / record.dt_s;
+  if (record.dt_s > 0.0) input.skid_per_m_rad = lateral.skid_s / record.dt_s;
   input.integration = integration_;
   input.axle_track_m = params_.axle_track_m;
   const double drift = params_.self_calibration.wheel_slip_drift_std_per_sqrt_m;
@@ -243,7 +248,7 @@ MotionInput EkfSlam::CheckedMotionInput(const SensorRecord& record) const {
 }
 
 void EkfSlam::Predict(const SensorRecord& record, const MotionInput& input) {
-  if (params_.input == "odometry") {
+  if (PredictsFromOdometry(params_.process_model)) {
     X_OR_previous_ = record.X_OR;
     has_odometry_ = true;
   }

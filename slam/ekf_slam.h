@@ -86,7 +86,8 @@ class EkfSlam {
  public:
   /// X_WR0: known initial pose of R (the point of control h) in W; its
   /// covariance is from `params` (zero by default, as in the paper). X_RS:
-  /// the laser mount on R. With `input: odometry`, only the increments of
+  /// the laser mount on R. With the process model of kind
+  /// odometry, only the increments of
   /// X_OR between consecutive records enter, so any fixed frame O works; the
   /// first record is their reference (it predicts no motion).
   /// `rng`: the stream of the `random` selection policy (only the selective
@@ -189,7 +190,7 @@ class EkfSlam {
 
   EkfParams params_;
   CorrectionMode mode_;
-  MotionIntegration integration_;  // params_.motion_integration
+  MotionIntegration integration_;  // of params_.process_model
   SelectionPolicy policy_;         // params_.selection_policy
   Rng rng_;                        // draws of SelectionPolicy::kRandom
   SlamState state_;

@@ -105,11 +105,11 @@ MotionInput CommandInput(const Twist2& command, double dt_s, const CommandNoiseP
                          const Twist2& previous) {
   MotionInput input;
   input.increment = Eigen::Vector2d(command.v_mps * dt_s, command.w_radps * dt_s);
-  const double sigma_v = noise.v_noise_std_mps + noise.v_noise_fraction * std::abs(command.v_mps) +
-                         noise.change_noise_fraction * std::abs(command.v_mps - previous.v_mps);
-  const double sigma_w = noise.w_noise_std_radps +
-                         noise.w_noise_fraction * std::abs(command.w_radps) +
-                         noise.change_noise_fraction * std::abs(command.w_radps - previous.w_radps);
+  const double sigma_v = noise.v_std_mps + noise.v_fraction * std::abs(command.v_mps) +
+                         noise.change_fraction * std::abs(command.v_mps - previous.v_mps);
+  const double sigma_w = noise.w_std_radps +
+                         noise.w_fraction * std::abs(command.w_radps) +
+                         noise.change_fraction * std::abs(command.w_radps - previous.w_radps);
   input.covariance = Eigen::Vector2d(dt_s * dt_s * sigma_v * sigma_v,
                                      dt_s * dt_s * sigma_w * sigma_w)
                          .asDiagonal();
@@ -134,13 +134,13 @@ MotionInput OdometryInput(const Pose2& X_OR_previous, const Pose2& X_OR, double 
   const double turn = std::abs(X_R0R1.theta);
   // Random-walk slip: variances linear in the distance rolled and the angle turned.
   const double variance_d =
-      noise.distance_noise_std_m * noise.distance_noise_std_m +
-      noise.distance_noise_std_m_per_sqrt_m * noise.distance_noise_std_m_per_sqrt_m * distance +
-      noise.distance_noise_std_m_per_sqrt_rad * noise.distance_noise_std_m_per_sqrt_rad * turn;
+      noise.distance_std_m * noise.distance_std_m +
+      noise.distance_std_m_per_sqrt_m * noise.distance_std_m_per_sqrt_m * distance +
+      noise.distance_std_m_per_sqrt_rad * noise.distance_std_m_per_sqrt_rad * turn;
   const double variance_th =
-      noise.heading_noise_std_rad * noise.heading_noise_std_rad +
-      noise.heading_noise_std_rad_per_sqrt_m * noise.heading_noise_std_rad_per_sqrt_m * distance +
-      noise.heading_noise_std_rad_per_sqrt_rad * noise.heading_noise_std_rad_per_sqrt_rad * turn;
+      noise.heading_std_rad * noise.heading_std_rad +
+      noise.heading_std_rad_per_sqrt_m * noise.heading_std_rad_per_sqrt_m * distance +
+      noise.heading_std_rad_per_sqrt_rad * noise.heading_std_rad_per_sqrt_rad * turn;
   input.covariance = Eigen::Vector2d(variance_d, variance_th).asDiagonal();
   return input;
 }

@@ -18,14 +18,14 @@ struct MotionInput {
   Eigen::Matrix2d covariance = Eigen::Matrix2d::Zero();
   /// Variance of a sideways slip of R over the step, m^2: a displacement
   /// across the mid-arc heading th + dth / 2 that Eq. (6) does not model,
-  /// independent of `increment` (EkfParams::lateral_slip_std_m_per_rad and
-  /// lateral_slip_std_m_per_sqrt_m).
+  /// independent of `increment` (LateralMotionParams::slip_std_m_per_rad and
+  /// slip_std_m_per_sqrt_m).
   double lateral_variance_m2 = 0.0;
   /// Skid to the outside of the turn, per metre and radian of `increment`:
-  /// R moves by -skid d dth across the mid-arc heading (EkfParams::lateral_skid_s
+  /// R moves by -skid d dth across the mid-arc heading (LateralMotionParams::skid_s
   /// divided by dt). 0: Eq. (6) alone.
   double skid_per_m_rad = 0.0;
-  /// How Eq. (6) is integrated over the step (EkfParams::motion_integration).
+  /// How Eq. (6) is integrated over the step (ProcessModel::integration).
   MotionIntegration integration = MotionIntegration::kExact;
   /// Variance of each wheel's slip fraction per metre it rolls, with
   /// self-calibration (SelfCalibrationParams::wheel_slip_drift_std_per_sqrt_m
@@ -55,8 +55,7 @@ Eigen::Vector3d PredictPose(const Eigen::Vector3d& pose_WR, const Eigen::Vector2
 
 /// The command (v, w) held over `dt_s` (>= 0) as an input: increment
 /// (v dt, w dt), covariance diag((dt sigma_v)^2, (dt sigma_w)^2) with
-///   sigma_v = v_noise_std_mps + v_noise_fraction |v|
-///             + change_noise_fraction |v - previous.v|,
+///   sigma_v = v_std_mps + v_fraction |v| + change_fraction |v - previous.v|,
 /// sigma_w likewise, `previous` the command of the record before
 /// (CommandNoiseParams).
 MotionInput CommandInput(const Twist2& command, double dt_s, const CommandNoiseParams& noise,

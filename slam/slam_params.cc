@@ -23,7 +23,7 @@ int IndexOfName(const char* const (&names)[N], const std::string& name, const ch
 
 MotionIntegration MotionIntegrationFromName(const std::string& name) {
   return static_cast<MotionIntegration>(
-      IndexOfName(kMotionIntegrationNames, name, "motion_integration"));
+      IndexOfName(kMotionIntegrationNames, name, "process_model.integration"));
 }
 
 JacobianPoint JacobianPointFromName(const std::string& name) {
@@ -37,25 +37,33 @@ SelectionPolicy SelectionPolicyFromName(const std::string& name) {
 
 std::vector<ParamProblem> CommandNoiseParams::Validate() const {
   ParamChecker check;
-  check.NonNegative("v_noise_std_mps", v_noise_std_mps);
-  check.NonNegative("v_noise_fraction", v_noise_fraction);
-  check.NonNegative("w_noise_std_radps", w_noise_std_radps);
-  check.NonNegative("w_noise_fraction", w_noise_fraction);
-  check.NonNegative("change_noise_fraction", change_noise_fraction);
+  check.NonNegative("v_std_mps", v_std_mps);
+  check.NonNegative("v_fraction", v_fraction);
+  check.NonNegative("w_std_radps", w_std_radps);
+  check.NonNegative("w_fraction", w_fraction);
+  check.NonNegative("change_fraction", change_fraction);
   // A zero constant part would make a stopped robot's prediction exact.
-  check.Require(v_noise_std_mps > 0.0 || w_noise_std_radps > 0.0, "v_noise_std_mps",
-                v_noise_std_mps, "a value > 0 when w_noise_std_radps is 0");
+  check.Require(v_std_mps > 0.0 || w_std_radps > 0.0, "v_std_mps", v_std_mps,
+                "a value > 0 when w_std_radps is 0");
   return check.problems();
 }
 
 std::vector<ParamProblem> OdometryNoiseParams::Validate() const {
   ParamChecker check;
-  check.NonNegative("distance_noise_std_m", distance_noise_std_m);
-  check.NonNegative("distance_noise_std_m_per_sqrt_m", distance_noise_std_m_per_sqrt_m);
-  check.NonNegative("distance_noise_std_m_per_sqrt_rad", distance_noise_std_m_per_sqrt_rad);
-  check.NonNegative("heading_noise_std_rad", heading_noise_std_rad);
-  check.NonNegative("heading_noise_std_rad_per_sqrt_m", heading_noise_std_rad_per_sqrt_m);
-  check.NonNegative("heading_noise_std_rad_per_sqrt_rad", heading_noise_std_rad_per_sqrt_rad);
+  check.NonNegative("distance_std_m", distance_std_m);
+  check.NonNegative("distance_std_m_per_sqrt_m", distance_std_m_per_sqrt_m);
+  check.NonNegative("distance_std_m_per_sqrt_rad", distance_std_m_per_sqrt_rad);
+  check.NonNegative("heading_std_rad", heading_std_rad);
+  check.NonNegative("heading_std_rad_per_sqrt_m", heading_std_rad_per_sqrt_m);
+  check.NonNegative("heading_std_rad_per_sqrt_rad", heading_std_rad_per_sqrt_rad);
+  return check.problems();
+}
+
+std::vector<ParamProblem> LateralMotionParams::Validate() const {
+  ParamChecker check;
+  check.NonNegative("slip_std_m_per_rad", slip_std_m_per_rad);
+  check.NonNegative("slip_std_m_per_sqrt_m", slip_std_m_per_sqrt_m);
+  check.NonNegative("skid_s", skid_s);
   return check.problems();
 }
 
@@ -72,20 +80,12 @@ std::vector<ParamProblem> SelfCalibrationParams::Validate() const {
 
 std::vector<ParamProblem> EkfParams::Validate() const {
   ParamChecker check;
-  check.OneOf("input", input, {"command", "odometry"});
-  check.OneOf("motion_integration", motion_integration,
-              std::vector<std::string>(std::begin(kMotionIntegrationNames),
-                                       std::end(kMotionIntegrationNames)));
+  check.Merge("process_model", ValidateProcessModel(process_model));
   check.Positive("control_point_offset_m", control_point_offset_m);
   check.Positive("axle_track_m", axle_track_m);
   check.Require(std::isfinite(control_point_offset_m), "control_point_offset_m",
                 control_point_offset_m, "a finite value");
-  check.Merge("command_noise", command_noise.Validate());
-  check.Merge("odometry_noise", odometry_noise.Validate());
   check.Merge("self_calibration", self_calibration.Validate());
-  check.NonNegative("lateral_slip_std_m_per_rad", lateral_slip_std_m_per_rad);
-  check.NonNegative("lateral_slip_std_m_per_sqrt_m", lateral_slip_std_m_per_sqrt_m);
-  check.NonNegative("lateral_skid_s", lateral_skid_s);
   check.OneOf("jacobians", jacobians,
               std::vector<std::string>(std::begin(kJacobianPointNames),
                                        std::end(kJacobianPointNames)));

@@ -1,6 +1,8 @@
 #pragma once
 
+#include <iterator>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "common/params.h"
@@ -10,7 +12,7 @@
 namespace mjslam::slam {
 
 /// How the prediction integrates the paper's Eq. (6) over one step
-/// (`slam.ekf.motion_integration`; docs/method.md, departure 9).
+/// (`slam.ekf.process_model.integration`; docs/method.md, departure 9).
 enum class MotionIntegration {
   /// The axle centre on the arc the held input describes (the default).
   kExact,
@@ -55,7 +57,7 @@ inline constexpr const char* kJacobianPointNames[] = {"current", "first_estimate
 inline constexpr const char* kSelectionPolicyNames[] = {"criterion", "first", "random",
                                                         "least_informative", "determinant"};
 
-/// The enum of a `slam.ekf.motion_integration` value. Throws ParamError for
+/// The enum of a `slam.ekf.process_model.integration` value. Throws ParamError for
 /// a name not in kMotionIntegrationNames.
 MotionIntegration MotionIntegrationFromName(const std::string& name);
 /// The enum of a `slam.ekf.jacobians` value. Throws ParamError for a name not
@@ -65,34 +67,45 @@ JacobianPoint JacobianPointFromName(const std::string& name);
 /// name not in kSelectionPolicyNames.
 SelectionPolicy SelectionPolicyFromName(const std::string& name);
 
-/// Noise of the commanded velocities as the filter's input (`input:
-/// command`). The robot's real motion differs from the command through the
-/// wheel dynamics (lag, acceleration limits, slip), so these must cover that
-/// difference, not only actuator noise. One standard deviation each, held
-/// over the record's `dt_s`: sigma_v = v_noise_std_mps + v_noise_fraction |v|
-/// + change_noise_fraction |v - v_prev|, likewise sigma_w. Serialized under `slam.ekf.command_noise.*`.
+/// Noise of the commanded velocities as the filter's input (the process
+/// model of kind `command`). The robot's real motion differs from the command
+/// through the wheel dynamics (lag, acceleration limits, slip), so these must
+/// cover that difference, not only actuator noise. One standard deviation
+/// each, held over the record's `dt_s`: sigma_v = v_std_mps + v_fraction |v|
+/// + change_fraction |v - v_prev|, likewise sigma_w. Serialized under
+/// `slam.ekf.process_model.noise.*` (with `kind: command`).
 struct CommandNoiseParams {
+  /// The process model's `kind` that has this noise.
+  static constexpr const char* kKind = "command";
   /// Constant part of the linear-velocity noise, m/s.
-  double v_noise_std_mps = 0.03;
+  double v_std_mps = 0.03;
   /// Part of the linear-velocity noise proportional to |v| (dimensionless).
-  double v_noise_fraction = 0.1;
+  double v_fraction = 0.1;
   /// Constant part of the angular-velocity noise, rad/s.
-  double w_noise_std_radps = 0.03;
+  double w_std_radps = 0.03;
   /// Part of the angular-velocity noise proportional to |w| (dimensionless).
-  double w_noise_fraction = 0.1;
+  double w_fraction = 0.1;
   /// Part of the noise proportional to the change of the command since the
   /// previous record, |v - v_prev| and |w - w_prev| (dimensionless): the
   /// wheels follow a step in the command with a lag, so the motion over the
   /// period lies between the two commands.
-  double change_noise_fraction = 0.5;
+  double change_fraction = 0.5;
+
+  /// The keys before the process model was a tagged choice.
+  static constexpr RetiredKey kRetiredKeys[] = {
+      {"v_noise_std_mps", "v_std_mps", ""},
+      {"v_noise_fraction", "v_fraction", ""},
+      {"w_noise_std_radps", "w_std_radps", ""},
+      {"w_noise_fraction", "w_fraction", ""},
+      {"change_noise_fraction", "change_fraction", ""}};
 
   template <typename Archive>
   void Serialize(Archive* a) {
-    a->Visit(MJSLAM_NVP(v_noise_std_mps));
-    a->Visit(MJSLAM_NVP(v_noise_fraction));
-    a->Visit(MJSLAM_NVP(w_noise_std_radps));
-    a->Visit(MJSLAM_NVP(w_noise_fraction));
-    a->Visit(MJSLAM_NVP(change_noise_fraction));
+    a->Visit(MJSLAM_NVP(v_std_mps));
+    a->Visit(MJSLAM_NVP(v_fraction));
+    a->Visit(MJSLAM_NVP(w_std_radps));
+    a->Visit(MJSLAM_NVP(w_fraction));
+    a->Visit(MJSLAM_NVP(change_fraction));
   }
   /// Every out-of-range field, keys relative to this struct.
   std::vector<ParamProblem> Validate() const;
@@ -100,47 +113,158 @@ struct CommandNoiseParams {
   void ValidateOrThrow() const { ThrowIfProblems(Validate()); }
 };
 
-/// Noise of the wheel-odometry increment as the filter's input (`input:
-/// odometry`), per record, with d the distance increment (m) and dth the
-/// heading increment (rad) between two records. Wheel slip is a random walk:
-/// its variance grows with the distance rolled and the angle turned, not with
-/// their squares (so the model does not depend on the record rate):
-///   sigma_d^2   = distance_noise_std_m^2 + distance_noise_std_m_per_sqrt_m^2 |d|
-///                 + distance_noise_std_m_per_sqrt_rad^2 |dth|,
-///   sigma_dth^2 = heading_noise_std_rad^2 + heading_noise_std_rad_per_sqrt_m^2 |d|
-///                 + heading_noise_std_rad_per_sqrt_rad^2 |dth|.
+/// Noise of the wheel-odometry increment as the filter's input (the process
+/// model of kind `odometry`), per record, with d the distance increment (m)
+/// and dth the heading increment (rad) between two records. Wheel slip is a
+/// random walk: its variance grows with the distance rolled and the angle
+/// turned, not with their squares (so the model does not depend on the
+/// record rate):
+///   sigma_d^2   = distance_std_m^2 + distance_std_m_per_sqrt_m^2 |d|
+///                 + distance_std_m_per_sqrt_rad^2 |dth|,
+///   sigma_dth^2 = heading_std_rad^2 + heading_std_rad_per_sqrt_m^2 |d|
+///                 + heading_std_rad_per_sqrt_rad^2 |dth|.
 /// The defaults are twice the simulator's default slip (0.5 % of a metre per
 /// wheel, 0.33 m track: 0.0035 m and 0.021 rad after 1 m, 0.0087 rad after
-/// 1 rad turned). Serialized under `slam.ekf.odometry_noise.*`.
+/// 1 rad turned). Serialized under `slam.ekf.process_model.noise.*` (with
+/// `kind: odometry`).
 struct OdometryNoiseParams {
+  /// The process model's `kind` that has this noise.
+  static constexpr const char* kKind = "odometry";
   /// Noise floor of the distance increment per record, metres.
-  double distance_noise_std_m = 0.0005;
+  double distance_std_m = 0.0005;
   /// Standard deviation of the distance after 1 m rolled, m per sqrt(m).
-  double distance_noise_std_m_per_sqrt_m = 0.007;
+  double distance_std_m_per_sqrt_m = 0.007;
   /// Standard deviation of the distance after 1 rad turned, m per sqrt(rad):
   /// the wheels' slip moves a robot that turns on the spot forward or back.
-  double distance_noise_std_m_per_sqrt_rad = 0.0;
+  double distance_std_m_per_sqrt_rad = 0.0;
   /// Noise floor of the heading increment per record, radians.
-  double heading_noise_std_rad = 0.0005;
+  double heading_std_rad = 0.0005;
   /// Standard deviation of the heading after 1 m rolled, rad per sqrt(m).
-  double heading_noise_std_rad_per_sqrt_m = 0.04;
+  double heading_std_rad_per_sqrt_m = 0.04;
   /// Standard deviation of the heading after 1 rad turned, rad per sqrt(rad).
-  double heading_noise_std_rad_per_sqrt_rad = 0.02;
+  double heading_std_rad_per_sqrt_rad = 0.02;
+
+  /// The keys before the process model was a tagged choice.
+  static constexpr RetiredKey kRetiredKeys[] = {
+      {"distance_noise_std_m", "distance_std_m", ""},
+      {"distance_noise_std_m_per_sqrt_m", "distance_std_m_per_sqrt_m", ""},
+      {"distance_noise_std_m_per_sqrt_rad", "distance_std_m_per_sqrt_rad", ""},
+      {"heading_noise_std_rad", "heading_std_rad", ""},
+      {"heading_noise_std_rad_per_sqrt_m", "heading_std_rad_per_sqrt_m", ""},
+      {"heading_noise_std_rad_per_sqrt_rad", "heading_std_rad_per_sqrt_rad", ""}};
 
   template <typename Archive>
   void Serialize(Archive* a) {
-    a->Visit(MJSLAM_NVP(distance_noise_std_m));
-    a->Visit(MJSLAM_NVP(distance_noise_std_m_per_sqrt_m));
-    a->Visit(MJSLAM_NVP(distance_noise_std_m_per_sqrt_rad));
-    a->Visit(MJSLAM_NVP(heading_noise_std_rad));
-    a->Visit(MJSLAM_NVP(heading_noise_std_rad_per_sqrt_m));
-    a->Visit(MJSLAM_NVP(heading_noise_std_rad_per_sqrt_rad));
+    a->Visit(MJSLAM_NVP(distance_std_m));
+    a->Visit(MJSLAM_NVP(distance_std_m_per_sqrt_m));
+    a->Visit(MJSLAM_NVP(distance_std_m_per_sqrt_rad));
+    a->Visit(MJSLAM_NVP(heading_std_rad));
+    a->Visit(MJSLAM_NVP(heading_std_rad_per_sqrt_m));
+    a->Visit(MJSLAM_NVP(heading_std_rad_per_sqrt_rad));
   }
   /// Every out-of-range field, keys relative to this struct.
   std::vector<ParamProblem> Validate() const;
   /// Throws ParamError listing every problem of Validate().
   void ValidateOrThrow() const { ThrowIfProblems(Validate()); }
 };
+
+/// Sideways motion of R that Eq. (6) lacks, with either input
+/// (`slam.ekf.process_model.lateral.*`).
+struct LateralMotionParams {
+  /// Lateral slip of R per radian turned, one standard deviation, metres per
+  /// radian: what the skid below leaves unmodelled. The prediction adds
+  /// (k |dth|)^2 of variance across the mid-arc heading (docs/method.md,
+  /// departure 10).
+  double slip_std_m_per_rad = 0.005;
+  /// Lateral slip of R per metre rolled, one standard deviation after 1 m,
+  /// metres per sqrt(metre): a sideways random walk over the distance
+  /// driven. The prediction adds k^2 |d| of variance across the mid-arc
+  /// heading, in addition to the term per radian above.
+  double slip_std_m_per_sqrt_m = 0.0;
+  /// Sideways skid of the axle centre in turns, seconds: Eq. (6) has no
+  /// sideways motion, but tyres skid to the outside of a turn at a speed
+  /// proportional to the centripetal acceleration, c v w. The prediction
+  /// moves R by c d dth / dt across the mid-arc heading, to the outside
+  /// (d, dth: the step's increment; nothing when dt = 0). 0: Eq. (6) as in
+  /// the paper. The default is the simulated Pioneer's, measured from the
+  /// true motion (docs/method.md, departure 13).
+  double skid_s = 0.0102;
+
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit(MJSLAM_NVP(slip_std_m_per_rad));
+    a->Visit(MJSLAM_NVP(slip_std_m_per_sqrt_m));
+    a->Visit(MJSLAM_NVP(skid_s));
+  }
+  /// Every out-of-range field, keys relative to this struct.
+  std::vector<ParamProblem> Validate() const;
+  /// Throws ParamError listing every problem of Validate().
+  void ValidateOrThrow() const { ThrowIfProblems(Validate()); }
+};
+
+/// The process model (Eq. 6) driven by one kind of input, whose noise is
+/// `Noise` (CommandNoiseParams or OdometryNoiseParams; GTSAM's noise model
+/// as a class). The two kinds share the integration and the lateral motion;
+/// each has only its own noise. Serialized under `slam.ekf.process_model.*`
+/// as a tagged choice: `kind: command` or `kind: odometry`, then this
+/// kind's keys (config/README.md, "Tagged choices").
+template <typename Noise>
+struct ProcessModel {
+  /// The `kind` of this process model.
+  static constexpr const char* kKind = Noise::kKind;
+  /// How Eq. (6) is integrated over a step: "exact" (the axle centre on an
+  /// arc, docs/method.md departure 9) or "euler" (the paper's forward-Euler
+  /// step). Read as MotionIntegration.
+  std::string integration = "exact";
+  /// The input's noise.
+  Noise noise;
+  /// Sideways motion Eq. (6) lacks.
+  LateralMotionParams lateral;
+
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit(MJSLAM_NVP(integration));
+    a->Visit(MJSLAM_NVP(noise));
+    a->Visit(MJSLAM_NVP(lateral));
+  }
+  /// Every out-of-range field, keys relative to this struct.
+  std::vector<ParamProblem> Validate() const {
+    ParamChecker check;
+    check.OneOf("integration", integration,
+                std::vector<std::string>(std::begin(kMotionIntegrationNames),
+                                         std::end(kMotionIntegrationNames)));
+    check.Merge("noise", noise.Validate());
+    check.Merge("lateral", lateral.Validate());
+    return check.problems();
+  }
+};
+
+/// The paper's: the record's command held over its dt (`kind: command`).
+using CommandProcessModel = ProcessModel<CommandNoiseParams>;
+/// The wheel-odometry increment between consecutive records, turned into the
+/// equivalent input (`kind: odometry`; docs/method.md, departure 2).
+using OdometryProcessModel = ProcessModel<OdometryNoiseParams>;
+/// What drives the prediction: one of the two kinds
+/// (`slam.ekf.process_model`). Dispatch with std::visit or std::get_if.
+using ProcessModelParams = std::variant<CommandProcessModel, OdometryProcessModel>;
+
+/// Whether `model` is of kind odometry (else: command).
+inline bool PredictsFromOdometry(const ProcessModelParams& model) {
+  return std::holds_alternative<OdometryProcessModel>(model);
+}
+/// The integration of either kind.
+inline const std::string& IntegrationOf(const ProcessModelParams& model) {
+  return std::visit([](const auto& m) -> const std::string& { return m.integration; }, model);
+}
+/// The lateral motion of either kind.
+inline const LateralMotionParams& LateralOf(const ProcessModelParams& model) {
+  return std::visit([](const auto& m) -> const LateralMotionParams& { return m.lateral; },
+                    model);
+}
+/// Every out-of-range field of either kind, keys relative to it.
+inline std::vector<ParamProblem> ValidateProcessModel(const ProcessModelParams& model) {
+  return std::visit([](const auto& m) { return m.Validate(); }, model);
+}
 
 /// Self-calibration (docs/method.md, "Self-calibration"): the robot's
 /// systematic errors estimated in the state, next to the pose, each from a
@@ -197,14 +321,10 @@ struct SelfCalibrationParams {
 /// Parameters of the EKF-SLAM filters (slam/README.md, "The filter").
 /// Serialized under `slam.ekf.*`.
 struct EkfParams {
-  /// What drives the prediction (Eq. 6): "command" (the record's command held
-  /// over dt, as in the paper) or "odometry" (the wheel-odometry increment
-  /// between consecutive records, turned into the equivalent input).
-  std::string input = "command";
-  /// How Eq. (6) is integrated over a step: "exact" (the axle centre on an
-  /// arc, docs/method.md departure 9) or "euler" (the paper's forward-Euler
-  /// step). Read as MotionIntegration.
-  std::string motion_integration = "exact";
+  /// What drives the prediction (Eq. 6) and its noise: the paper's
+  /// commands (CommandProcessModel, the default) or the wheel odometry
+  /// (OdometryProcessModel).
+  ProcessModelParams process_model;
   /// Offset `a` of the point of control h (frame R) ahead of the wheel axle,
   /// metres (> 0). Must match the robot's (`robot.control_point_offset_m`).
   double control_point_offset_m = 0.2;
@@ -213,31 +333,8 @@ struct EkfParams {
   /// wheels' travel, uses it.
   /// Must match the robot's (`robot.axle_track_m`).
   double axle_track_m = 0.33;
-  /// Input noise when `input` is "command".
-  CommandNoiseParams command_noise;
-  /// Input noise when `input` is "odometry".
-  OdometryNoiseParams odometry_noise;
   /// The systematic errors estimated in the state (SelfCalibrationParams).
   SelfCalibrationParams self_calibration;
-  /// Lateral slip of R per radian turned, one standard deviation, metres per
-  /// radian, with either input: what the skid below leaves unmodelled. The
-  /// prediction adds (k |dth|)^2 of variance across the mid-arc heading
-  /// (docs/method.md, departure 10).
-  double lateral_slip_std_m_per_rad = 0.005;
-  /// Lateral slip of R per metre rolled, one standard deviation after 1 m,
-  /// metres per sqrt(metre), with either input: a sideways random walk over
-  /// the distance driven. The prediction adds k^2 |d| of variance across the
-  /// mid-arc heading, in addition to the term per radian above.
-  double lateral_slip_std_m_per_sqrt_m = 0.0;
-  /// Sideways skid of the axle centre in turns, seconds: Eq. (6) has no
-  /// sideways motion, but tyres skid to the outside of a turn at a speed
-  /// proportional to the centripetal acceleration, c v w. The prediction
-  /// moves R by c d dth / dt across the mid-arc heading, to the outside
-  /// (d, dth: the step's increment; nothing when dt = 0). 0: Eq. (6) as in
-  /// the paper. The default is the simulated Pioneer's, measured from the
-  /// true motion (docs/method.md, departure 13).
-  double lateral_skid_s = 0.0102;
-
   /// Where the Jacobians are evaluated: "current" (the standard EKF, the
   /// paper's) or "first_estimates" (FEJ-EKF, docs/method.md departure 20).
   /// Read as JacobianPoint.
@@ -320,18 +417,25 @@ struct EkfParams {
   /// "determinant" (SelectionPolicy). Ignored by the classical filter.
   std::string selection_policy = "criterion";
 
+  /// The flat keys of the process model before it was a tagged choice; a
+  /// config that gives one is told the key that replaced it.
+  static constexpr RetiredKey kRetiredKeys[] = {
+      {"input", "process_model.kind", "input: odometry is now process_model: {kind: odometry}"},
+      {"motion_integration", "process_model.integration", ""},
+      {"command_noise", "process_model.noise",
+       "with process_model.kind: command; each key without '_noise', as v_std_mps"},
+      {"odometry_noise", "process_model.noise",
+       "with process_model.kind: odometry; each key without '_noise', as distance_std_m"},
+      {"lateral_slip_std_m_per_rad", "process_model.lateral.slip_std_m_per_rad", ""},
+      {"lateral_slip_std_m_per_sqrt_m", "process_model.lateral.slip_std_m_per_sqrt_m", ""},
+      {"lateral_skid_s", "process_model.lateral.skid_s", ""}};
+
   template <typename Archive>
   void Serialize(Archive* a) {
-    a->Visit(MJSLAM_NVP(input));
-    a->Visit(MJSLAM_NVP(motion_integration));
+    a->Visit(MJSLAM_NVP(process_model));
     a->Visit(MJSLAM_NVP(control_point_offset_m));
     a->Visit(MJSLAM_NVP(axle_track_m));
-    a->Visit(MJSLAM_NVP(command_noise));
-    a->Visit(MJSLAM_NVP(odometry_noise));
     a->Visit(MJSLAM_NVP(self_calibration));
-    a->Visit(MJSLAM_NVP(lateral_slip_std_m_per_rad));
-    a->Visit(MJSLAM_NVP(lateral_slip_std_m_per_sqrt_m));
-    a->Visit(MJSLAM_NVP(lateral_skid_s));
     a->Visit(MJSLAM_NVP(jacobians));
     a->Visit(MJSLAM_NVP(initial_position_std_m));
     a->Visit(MJSLAM_NVP(initial_heading_std_rad));
@@ -350,7 +454,7 @@ struct EkfParams {
     a->Visit(MJSLAM_NVP(selection_policy));
   }
   /// Every out-of-range field, keys relative to this struct (nested ones as
-  /// `command_noise.v_noise_std_mps`, ...).
+  /// `process_model.noise.v_std_mps`, ...).
   std::vector<ParamProblem> Validate() const;
   /// Throws ParamError listing every problem of Validate().
   void ValidateOrThrow() const { ThrowIfProblems(Validate()); }

@@ -21,7 +21,7 @@ namespace {
 constexpr double kA = 0.2;      // control point offset, m
 constexpr double kB = 0.33;     // axle track, m
 constexpr double kDt = 0.1;     // record period, s
-constexpr double kSkid = 0.01;  // lateral_skid_s
+constexpr double kSkid = 0.01;  // process_model.lateral.skid_s
 
 struct TrueModel {
   double distance_per_sqrt_m = 0.008;
@@ -92,20 +92,23 @@ TEST(CalibrateTest, RecoversTheNoiseTheSkidAndEachRunsSystematicErrors) {
   std::vector<RunSystematics> drawn(20);
   for (int r = 0; r < 20; ++r) runs.push_back(SyntheticRun(r, 1500, m, &drawn[r]));
   const Calibration c = Calibrate(runs, Model(), 10);
-  const slam::OdometryNoiseParams& n = c.fitted.odometry_noise;
+  const slam::OdometryProcessModel& fitted =
+      std::get<slam::OdometryProcessModel>(c.fitted.process_model);
+  const slam::OdometryNoiseParams& n = fitted.noise;
   // 3000 windows: the standard deviations within 10 %, the floors and the
   // per-radian lateral term (none drawn) small.
-  EXPECT_NEAR(n.distance_noise_std_m_per_sqrt_m, m.distance_per_sqrt_m, 0.1 * m.distance_per_sqrt_m);
-  EXPECT_NEAR(n.distance_noise_std_m_per_sqrt_rad, m.distance_per_sqrt_rad,
+  EXPECT_NEAR(n.distance_std_m_per_sqrt_m, m.distance_per_sqrt_m, 0.1 * m.distance_per_sqrt_m);
+  EXPECT_NEAR(n.distance_std_m_per_sqrt_rad, m.distance_per_sqrt_rad,
               0.1 * m.distance_per_sqrt_rad);
-  EXPECT_NEAR(n.heading_noise_std_rad_per_sqrt_m, m.heading_per_sqrt_m, 0.1 * m.heading_per_sqrt_m);
-  EXPECT_NEAR(n.heading_noise_std_rad_per_sqrt_rad, m.heading_per_sqrt_rad,
+  EXPECT_NEAR(n.heading_std_rad_per_sqrt_m, m.heading_per_sqrt_m, 0.1 * m.heading_per_sqrt_m);
+  EXPECT_NEAR(n.heading_std_rad_per_sqrt_rad, m.heading_per_sqrt_rad,
               0.1 * m.heading_per_sqrt_rad);
-  EXPECT_NEAR(c.fitted.lateral_slip_std_m_per_sqrt_m, m.lateral_per_sqrt_m, 0.1 * m.lateral_per_sqrt_m);
-  EXPECT_LT(n.distance_noise_std_m, 2e-4);
-  EXPECT_LT(n.heading_noise_std_rad, 1e-3);
-  EXPECT_LT(c.fitted.lateral_slip_std_m_per_rad, 2e-4);
-  EXPECT_NEAR(c.fitted.lateral_skid_s, kSkid, 0.05 * kSkid);
+  EXPECT_NEAR(fitted.lateral.slip_std_m_per_sqrt_m, m.lateral_per_sqrt_m,
+              0.1 * m.lateral_per_sqrt_m);
+  EXPECT_LT(n.distance_std_m, 2e-4);
+  EXPECT_LT(n.heading_std_rad, 1e-3);
+  EXPECT_LT(fitted.lateral.slip_std_m_per_rad, 2e-4);
+  EXPECT_NEAR(fitted.lateral.skid_s, kSkid, 0.05 * kSkid);
   // Each run's systematic errors, least squares over its records: their
   // errors are those of a 150 s run, so the test bounds the RMS over the
   // runs at a third of the drawn spread (0.01, 0.02 and 0.03).
@@ -143,11 +146,28 @@ TEST(CalibrateTest, TheWrittenConfigHoldsTheFittedKeysOnItsBase) {
   std::ofstream(path) << CalibrationYaml(c, std::string(MJSLAM_SOURCE_DIR) + "/configs/default.yaml",
                                          "test");
   const RunConfig loaded = LoadRunConfig(path, {});
-  EXPECT_EQ(loaded.slam.ekf.odometry_noise.heading_noise_std_rad_per_sqrt_m,
-            c.fitted.odometry_noise.heading_noise_std_rad_per_sqrt_m);
-  EXPECT_EQ(loaded.slam.ekf.lateral_slip_std_m_per_sqrt_m, c.fitted.lateral_slip_std_m_per_sqrt_m);
-  EXPECT_EQ(loaded.slam.ekf.lateral_skid_s, c.fitted.lateral_skid_s);
-  EXPECT_EQ(loaded.slam.ekf.input, "odometry");  // from the base
+  const slam::OdometryProcessModel& fitted =
+      std::get<slam::OdometryProcessModel>(c.fitted.process_model);
+  const auto* read = std::get_if<slam::OdometryProcessModel>(&loaded.slam.ekf.process_model);
+  ASSERT_NE(read, nullptr);
+  EXPECT_EQ(read->noise.heading_std_rad_per_sqrt_m, fitted.noise.heading_std_rad_per_sqrt_m);
+  EXPECT_EQ(read->lateral.slip_std_m_per_sqrt_m, fitted.lateral.slip_std_m_per_sqrt_m);
+  EXPECT_EQ(read->lateral.skid_s, fitted.lateral.skid_s);
+  EXPECT_EQ(read->integration, "exact");
+
+  // On a base of kind command (paper.yaml: euler), the given model's
+  // integration is kept and the process model becomes of kind odometry.
+  slam::EkfParams given = Model();
+  std::get<slam::CommandProcessModel>(given.process_model).integration = "euler";
+  const Calibration euler = Calibrate(runs, given, 10);
+  std::ofstream(path) << CalibrationYaml(euler, std::string(MJSLAM_SOURCE_DIR) + "/configs/paper.yaml",
+                                         "test");
+  const RunConfig on_paper = LoadRunConfig(path, {});
+  const auto* switched = std::get_if<slam::OdometryProcessModel>(&on_paper.slam.ekf.process_model);
+  ASSERT_NE(switched, nullptr);
+  EXPECT_EQ(switched->integration, "euler");
+  EXPECT_EQ(switched->lateral.skid_s,
+            std::get<slam::OdometryProcessModel>(euler.fitted.process_model).lateral.skid_s);
 }
 
 TEST(CalibrateTest, RefusesTooFewWindowsAndRecordsThatAreNotFinite) {

@@ -41,12 +41,13 @@ RunConfig ShortConfig(const std::vector<std::string>& extra = {}) {
 }
 
 // Realtime timing, 8 s, the default cost model (a period that grows with the
-// map and differs between the filters), `input` as given.
+// map and differs between the filters), the process model of kind `input`
+// (of kind command: the built-in one).
 RunConfig RealtimeConfig(const std::string& input) {
   RunConfig config = LoadRunConfig(
       std::string(MJSLAM_SOURCE_DIR) + "/configs/default.yaml",
       {"run.duration_s=8", "explorer.initial_turn_deg=0", "slam.timing=realtime",
-       "control.model_s_per_update_per_n2=4e-5", "slam.ekf.input=" + input});
+       "control.model_s_per_update_per_n2=4e-5", "slam.ekf.process_model.kind=" + input});
   config.ValidateOrThrow();
   return config;
 }

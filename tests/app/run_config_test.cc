@@ -1,5 +1,8 @@
 #include <filesystem>
 #include <fstream>
+#include <string>
+#include <variant>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -110,6 +113,71 @@ TEST(RunConfigTest, AllProblemsReportedAtOnceWithPositions) {
     EXPECT_NE(what.find("laser.max_range_m"), std::string::npos) << what;
     EXPECT_NE(what.find("laser.bogus"), std::string::npos) << what;
   }
+}
+
+// The message of the error that loading `yaml` (over configs/default.yaml)
+// throws; `path` receives the file's name.
+std::string ProcessModelErrorOf(const std::string& yaml, std::string* path,
+                                const std::vector<std::string>& overrides = {}) {
+  const fs::path dir = fs::temp_directory_path() / "mjslam_run_config_test";
+  fs::create_directories(dir);
+  *path = (dir / "process_model.yaml").string();
+  std::ofstream(*path) << "base: " << MJSLAM_SOURCE_DIR << "/configs/default.yaml\n" << yaml;
+  try {
+    LoadRunConfig(*path, overrides);
+  } catch (const std::exception& error) {
+    return error.what();
+  }
+  ADD_FAILURE() << "expected an error for:\n" << yaml;
+  return {};
+}
+
+TEST(RunConfigTest, ProcessModelIsATaggedChoice) {
+  std::string path;
+  // A key of the other kind: file:line, the key and both kinds.
+  std::string what = ProcessModelErrorOf(
+      "slam:\n  ekf:\n    process_model:\n      noise:\n        v_std_mps: 0.1\n", &path);
+  EXPECT_NE(what.find(path + ":6:9: slam.ekf.process_model.noise.v_std_mps: a key of kind "
+                             "'command', not of kind 'odometry'"),
+            std::string::npos)
+      << what;
+  // The flat keys of before: at their line, with the key that replaced each.
+  what = ProcessModelErrorOf(
+      "slam:\n  ekf:\n    input: odometry\n    odometry_noise: {distance_noise_std_m: 0}\n"
+      "    lateral_skid_s: 0\n    process_model:\n      noise: {heading_noise_std_rad: 0}\n",
+      &path);
+  EXPECT_NE(what.find(path + ":4:5: slam.ekf.input: a retired key, now "
+                             "slam.ekf.process_model.kind"),
+            std::string::npos)
+      << what;
+  EXPECT_NE(what.find(path + ":5:5: slam.ekf.odometry_noise: a retired key, now "
+                             "slam.ekf.process_model.noise (with process_model.kind: odometry"),
+            std::string::npos)
+      << what;
+  EXPECT_NE(what.find(path + ":6:5: slam.ekf.lateral_skid_s: a retired key, now "
+                             "slam.ekf.process_model.lateral.skid_s"),
+            std::string::npos)
+      << what;
+  EXPECT_NE(what.find(path + ":8:15: slam.ekf.process_model.noise.heading_noise_std_rad: a "
+                             "retired key, now slam.ekf.process_model.noise.heading_std_rad"),
+            std::string::npos)
+      << what;
+  // Likewise from --set.
+  what = ProcessModelErrorOf("", &path, {"slam.ekf.motion_integration=euler"});
+  EXPECT_NE(what.find("--set slam.ekf.motion_integration=euler: slam.ekf.motion_integration: a "
+                      "retired key, now slam.ekf.process_model.integration"),
+            std::string::npos)
+      << what;
+  // --set of the kind starts the other kind from its built-in values.
+  const std::string defaults = std::string(MJSLAM_SOURCE_DIR) + "/configs/default.yaml";
+  const RunConfig command =
+      LoadRunConfig(defaults, {"slam.ekf.process_model.kind=command",
+                               "slam.ekf.process_model.noise.change_fraction=0"});
+  const auto* model = std::get_if<slam::CommandProcessModel>(&command.slam.ekf.process_model);
+  ASSERT_NE(model, nullptr);
+  EXPECT_EQ(model->noise.change_fraction, 0.0);
+  EXPECT_EQ(model->noise.v_std_mps, slam::CommandNoiseParams().v_std_mps);
+  EXPECT_EQ(model->lateral.skid_s, slam::LateralMotionParams().skid_s);
 }
 
 }  // namespace

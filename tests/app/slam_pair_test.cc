@@ -63,7 +63,7 @@ ControlParams ModelCost(double base_s) {
 slam::SlamParams Timing(const std::string& timing, const std::string& input) {
   slam::SlamParams params;
   params.timing = timing;
-  params.ekf.input = input;
+  if (input == "odometry") params.ekf.process_model = slam::OdometryProcessModel{};
   return params;
 }
 
@@ -224,7 +224,7 @@ TEST(SlamPairTest, RealtimeOdometryPredictionUsesTheWholeElapsedTime) {
     records[k].X_OR = Pose2(std::sin(th), 1.0 - std::cos(th), th);
   }
   slam::SlamParams params = Timing("realtime", "odometry");
-  ASSERT_GT(params.ekf.lateral_skid_s, 0.0);
+  ASSERT_GT(slam::LateralOf(params.ekf.process_model).skid_s, 0.0);
   SlamPair realtime(params, ModelCost(0.35), kDt, Pose2(), Pose2(), Rng(1));
   for (const SensorRecord& record : records) realtime.Step(record);
   ASSERT_TRUE(realtime.processed(0));

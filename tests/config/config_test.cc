@@ -12,6 +12,7 @@
 #include <fstream>
 #include <limits>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "tests/config/toy_params.h"
@@ -522,6 +523,125 @@ TEST(ConfigBaseTest, MapOfAnotherKindReplacesTheBasesMap) {
   ASSERT_TRUE(problems.empty());
   ASSERT_EQ(root.entries.at(0).value.entries.size(), 2u);
   EXPECT_EQ(root.entries.at(0).value.entries[1].value.scalar, "5");
+}
+
+// The message of the ConfigError that loading `yaml` as ChoiceToyParams throws.
+std::string ChoiceErrorOf(const std::string& yaml, const std::vector<std::string>& overrides = {}) {
+  try {
+    LoadConfigString<testing::ChoiceToyParams>(yaml, "x.yaml", overrides);
+  } catch (const ConfigError& error) {
+    return error.what();
+  }
+  ADD_FAILURE() << "no ConfigError for:\n" << yaml;
+  return {};
+}
+
+TEST(ConfigChoiceTest, KindPicksTheAlternativeAndAbsentKindKeepsTheCurrentOne) {
+  using testing::ChoiceToyParams;
+  using testing::CircleToyModel;
+  using testing::LineToyModel;
+  const auto circle = LoadConfigString<ChoiceToyParams>(
+      "model:\n  kind: circle\n  radius_m: 3\n  centre: {x_m: 1}\n", "x.yaml");
+  ASSERT_TRUE(std::holds_alternative<CircleToyModel>(circle.model));
+  EXPECT_EQ(std::get<CircleToyModel>(circle.model).radius_m, 3.0);
+  EXPECT_EQ(std::get<CircleToyModel>(circle.model).centre.x_m, 1.0);
+  EXPECT_EQ(std::get<CircleToyModel>(circle.model).inner.gain, 0.5);  // the default
+  // No kind: the current alternative (here the default, line) is read.
+  const auto line = LoadConfigString<ChoiceToyParams>("model:\n  slope: 2\n", "x.yaml");
+  ASSERT_TRUE(std::holds_alternative<LineToyModel>(line.model));
+  EXPECT_EQ(std::get<LineToyModel>(line.model).slope, 2.0);
+  EXPECT_TRUE(std::holds_alternative<LineToyModel>(
+      LoadConfigString<ChoiceToyParams>("model:\n", "x.yaml").model));
+  // A quoted kind (as ToYaml writes it) is the same kind.
+  EXPECT_TRUE(std::holds_alternative<CircleToyModel>(
+      LoadConfigString<ChoiceToyParams>("model: {kind: \"circle\"}\n", "x.yaml").model));
+}
+
+TEST(ConfigChoiceTest, KeyOfAnotherKindNamesFileLineKeyAndBothKinds) {
+  EXPECT_EQ(ChoiceErrorOf("rate_hz: 2\nmodel:\n  kind: circle\n  slope: 2\n"),
+            "x.yaml:4:3: model.slope: a key of kind 'line', not of kind 'circle' "
+            "(known keys of model: kind, radius_m, inner, centre)");
+  // In a nested map of the other kind too; a key of no kind stays unknown.
+  const std::string nested =
+      ChoiceErrorOf("model:\n  kind: line\n  centre: {x_m: 1}\n  inner: {gian: 1}\n");
+  EXPECT_TRUE(Contains(nested, "x.yaml:3:3: model.centre: a key of kind 'circle', not of kind 'line'"));
+  EXPECT_TRUE(Contains(nested, "x.yaml:4:11: model.inner.gian: unknown key, did you mean 'gain'?"));
+  // Without a kind in the map the message says whose kind it is.
+  EXPECT_TRUE(Contains(ChoiceErrorOf("model:\n  radius_m: 1\n"),
+                       "x.yaml:2:3: model.radius_m: a key of kind 'circle', not of kind 'line' "
+                       "(no kind given here: the base's or the default)"));
+}
+
+TEST(ConfigChoiceTest, RetiredKeysNameTheKeyThatReplacedThem) {
+  // At the top level and inside a choice's alternative, with the note.
+  const std::string what = ChoiceErrorOf("line_slope: 2\nmodel:\n  gradient: 3\n");
+  EXPECT_TRUE(Contains(what, "x.yaml:1:1: line_slope: a retired key, now model.slope "
+                             "(with model.kind: line)"))
+      << what;
+  EXPECT_TRUE(Contains(what + "\n", "x.yaml:3:3: model.gradient: a retired key, now model.slope\n"))
+      << what;
+}
+
+TEST(ConfigChoiceTest, BadKindValuesAndValidationProblemsPointAtTheirText) {
+  EXPECT_EQ(ChoiceErrorOf("model:\n  kind: square\n  slope: 2\n"),
+            "x.yaml:2:9: model.kind: expected line or circle (got square)");
+  EXPECT_EQ(ChoiceErrorOf("model:\n  kind: [line]\n"),
+            "x.yaml:2:9: model.kind: expected line or circle (got a sequence of 1 item)");
+  EXPECT_EQ(ChoiceErrorOf("model: circle\n"),
+            "x.yaml:1:8: model: expected a map with a kind (got circle)");
+  EXPECT_EQ(ChoiceErrorOf("model:\n  kind: circle\n  radius_m: -1\n"),
+            "x.yaml:3:13: model.radius_m: expected a value > 0 (got -1)");
+  EXPECT_TRUE(Contains(ChoiceErrorOf("model:\n  kind: line\n  kind: circle\n"),
+                       "x.yaml:3:3: model.kind: duplicate key"));
+}
+
+TEST(ConfigChoiceTest, WritesTheKindFirstAndLoadsBackIdentically) {
+  testing::ChoiceToyParams params;
+  testing::CircleToyModel circle;
+  circle.radius_m = 0.25;
+  circle.centre.y_m = -1.5;
+  params.model = circle;
+  const std::string text = ToYaml(params);
+  EXPECT_TRUE(Contains(text, "model:\n  kind: \"circle\"\n  radius_m: 0.25\n")) << text;
+  const auto again = LoadConfigString<testing::ChoiceToyParams>(text, "resolved");
+  EXPECT_EQ(ToYaml(again), text);
+  EXPECT_EQ(std::get<testing::CircleToyModel>(again.model).centre.y_m, -1.5);
+}
+
+TEST(ConfigChoiceTest, SettingAnotherKindDropsTheKeysOfTheOldOne) {
+  using testing::ChoiceToyParams;
+  using testing::CircleToyModel;
+  const std::string yaml = "model:\n  kind: line\n  slope: 3\n  inner: {gain: 0.25}\n";
+  // --set model.kind=circle is --set model={kind: circle}: every key of the
+  // line goes (its inner.gain too: a different choice starts from defaults).
+  for (const std::string option : {"model.kind=circle", "model={kind: circle}"}) {
+    const auto params = LoadConfigString<ChoiceToyParams>(yaml, "x.yaml", {option});
+    ASSERT_TRUE(std::holds_alternative<CircleToyModel>(params.model)) << option;
+    EXPECT_EQ(std::get<CircleToyModel>(params.model).inner.gain, 0.5) << option;
+  }
+  // The same kind again keeps the keys; then a key of the new kind applies.
+  const auto same = LoadConfigString<ChoiceToyParams>(yaml, "x.yaml", {"model.kind=line"});
+  EXPECT_EQ(std::get<testing::LineToyModel>(same.model).slope, 3.0);
+  const auto set = LoadConfigString<ChoiceToyParams>(yaml, "x.yaml",
+                                                     {"model.kind=circle", "model.radius_m=4"});
+  EXPECT_EQ(std::get<CircleToyModel>(set.model).radius_m, 4.0);
+  // A key of the old kind after the switch names both kinds and the option.
+  EXPECT_TRUE(Contains(ChoiceErrorOf(yaml, {"model.kind=circle", "model.slope=1"}),
+                       "--set model.slope=1: model.slope: a key of kind 'line', not of kind 'circle'"));
+}
+
+TEST(ConfigChoiceTest, AFileOfAnotherKindThanItsBaseTakesNothingFromTheBasesChoice) {
+  WriteFile("bases_choice", "a.yaml", "rate_hz: 4\nmodel:\n  kind: line\n  slope: 3\n");
+  const std::string same =
+      WriteFile("bases_choice", "same.yaml", "base: a.yaml\nmodel:\n  inner: {gain: 0.25}\n");
+  const std::string other =
+      WriteFile("bases_choice", "other.yaml", "base: a.yaml\nmodel:\n  kind: circle\n");
+  const auto merged = LoadConfigFile<testing::ChoiceToyParams>(same);
+  EXPECT_EQ(std::get<testing::LineToyModel>(merged.model).slope, 3.0);
+  EXPECT_EQ(std::get<testing::LineToyModel>(merged.model).inner.gain, 0.25);
+  const auto replaced = LoadConfigFile<testing::ChoiceToyParams>(other);
+  EXPECT_EQ(replaced.rate_hz, 4.0);
+  EXPECT_EQ(std::get<testing::CircleToyModel>(replaced.model).radius_m, 2.0);
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <array>
 #include <cstdint>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "common/params.h"
@@ -94,6 +95,82 @@ struct ToyParams {
     checker.Require(min_range_m < max_range_m, "min_range_m", min_range_m,
                     "a value < max_range_m");
     checker.Merge("laser", laser.Validate());
+    return checker.problems();
+  }
+};
+
+/// One alternative of a tagged choice (`kind: line`).
+struct LineToyModel {
+  static constexpr const char* kKind = "line";
+  /// Keys this struct no longer reads.
+  static constexpr RetiredKey kRetiredKeys[] = {{"gradient", "slope", ""}};
+  /// Slope, >= 0.
+  double slope = 1.0;
+  InnerToyParams inner;
+
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit(MJSLAM_NVP(slope));
+    a->Visit(MJSLAM_NVP(inner));
+  }
+
+  std::vector<ParamProblem> Validate() const {
+    ParamChecker checker;
+    checker.NonNegative("slope", slope);
+    checker.Merge("inner", inner.Validate());
+    return checker.problems();
+  }
+};
+
+/// The other alternative (`kind: circle`), with a nested map of its own.
+struct CircleToyModel {
+  static constexpr const char* kKind = "circle";
+  /// Radius (m), > 0.
+  double radius_m = 2.0;
+  InnerToyParams inner;
+  struct Centre {
+    double x_m = 0.0;
+    double y_m = 0.0;
+    template <typename Archive>
+    void Serialize(Archive* a) {
+      a->Visit(MJSLAM_NVP(x_m));
+      a->Visit(MJSLAM_NVP(y_m));
+    }
+  } centre;
+
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit(MJSLAM_NVP(radius_m));
+    a->Visit(MJSLAM_NVP(inner));
+    a->Visit(MJSLAM_NVP(centre));
+  }
+
+  std::vector<ParamProblem> Validate() const {
+    ParamChecker checker;
+    checker.Positive("radius_m", radius_m);
+    checker.Merge("inner", inner.Validate());
+    return checker.problems();
+  }
+};
+
+/// A struct with a tagged choice (`model: {kind: line | circle, ...}`).
+struct ChoiceToyParams {
+  double rate_hz = 10.0;
+  /// Keys this struct no longer reads.
+  static constexpr RetiredKey kRetiredKeys[] = {
+      {"line_slope", "model.slope", "with model.kind: line"}};
+  std::variant<LineToyModel, CircleToyModel> model;
+
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit(MJSLAM_NVP(rate_hz));
+    a->Visit(MJSLAM_NVP(model));
+  }
+
+  std::vector<ParamProblem> Validate() const {
+    ParamChecker checker;
+    checker.Positive("rate_hz", rate_hz);
+    checker.Merge("model", std::visit([](const auto& m) { return m.Validate(); }, model));
     return checker.problems();
   }
 };

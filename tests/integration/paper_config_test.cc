@@ -20,13 +20,15 @@ std::string PaperConfig() { return std::string(MJSLAM_SOURCE_DIR) + "/configs/pa
 // The keys paper.yaml turns to the paper's choice, checked on a loaded config.
 void ExpectPaperChoices(const app::RunConfig& config) {
   const slam::EkfParams& ekf = config.slam.ekf;
-  EXPECT_EQ(ekf.input, "command");
-  EXPECT_EQ(ekf.motion_integration, "euler");
-  EXPECT_EQ(ekf.lateral_slip_std_m_per_rad, 0.0);
-  EXPECT_EQ(ekf.lateral_slip_std_m_per_sqrt_m, 0.0);
+  const auto* command = std::get_if<slam::CommandProcessModel>(&ekf.process_model);
+  ASSERT_NE(command, nullptr);
+  EXPECT_EQ(command->integration, "euler");
+  EXPECT_EQ(command->lateral.slip_std_m_per_rad, 0.0);
+  EXPECT_EQ(command->lateral.slip_std_m_per_sqrt_m, 0.0);
+  EXPECT_EQ(command->lateral.skid_s, 0.0);
+  EXPECT_EQ(command->noise.change_fraction, 0.0);
   EXPECT_EQ(ekf.line_match_max_gap_m, 0.0);
   EXPECT_EQ(ekf.self_calibration.wheel_slip_drift_std_per_sqrt_m, 0.0);
-  EXPECT_EQ(ekf.lateral_skid_s, 0.0);
   EXPECT_TRUE(ekf.correct_corners_of_matched_lines);
   EXPECT_FALSE(ekf.corners_from_map_lines);
   EXPECT_FALSE(ekf.new_features_need_match);
@@ -34,7 +36,6 @@ void ExpectPaperChoices(const app::RunConfig& config) {
   EXPECT_EQ(ekf.extra_line_alpha_std_rad, 0.0);
   EXPECT_EQ(ekf.extra_corner_range_std_m, 0.0);
   EXPECT_EQ(ekf.extra_corner_bearing_std_rad, 0.0);
-  EXPECT_EQ(ekf.command_noise.change_noise_fraction, 0.0);
   EXPECT_EQ(ekf.jacobians, "current");
   EXPECT_EQ(ekf.max_updates, 2);
   EXPECT_EQ(ekf.selection_policy, "criterion");
@@ -47,13 +48,13 @@ TEST(PaperConfigTest, SetsEveryDepartureWithAKeyToThePapersChoice) {
   ExpectPaperChoices(paper);
   // And these are not the defaults: the file is what changes them.
   const app::RunConfig defaults = app::LoadRunConfig(DefaultConfig(), {});
-  EXPECT_EQ(defaults.slam.ekf.motion_integration, "exact");
-  EXPECT_GT(defaults.slam.ekf.lateral_skid_s, 0.0);
-  EXPECT_GT(defaults.slam.ekf.lateral_slip_std_m_per_rad, 0.0);
+  EXPECT_EQ(slam::IntegrationOf(defaults.slam.ekf.process_model), "exact");
+  EXPECT_GT(slam::LateralOf(defaults.slam.ekf.process_model).skid_s, 0.0);
+  EXPECT_GT(slam::LateralOf(defaults.slam.ekf.process_model).slip_std_m_per_rad, 0.0);
+  EXPECT_GT(slam::CommandNoiseParams().change_fraction, 0.0);  // the built-in command noise
   EXPECT_FALSE(defaults.slam.ekf.correct_corners_of_matched_lines);
   EXPECT_TRUE(defaults.slam.ekf.corners_from_map_lines);
   EXPECT_TRUE(defaults.slam.ekf.new_features_need_match);
-  EXPECT_GT(defaults.slam.ekf.command_noise.change_noise_fraction, 0.0);
   EXPECT_NE(defaults.control.pose_source, "odometry");
 }
 

@@ -52,7 +52,11 @@ RunErrors Run(CorrectionMode mode, std::uint64_t seed, double reported_variance_
               const std::string& input) {
   const SyntheticWorld world = RoomWithPillar(10.0, 8.0, 4.0, 3.0, 6.0, 5.0);
   EkfParams params;
-  params.input = input;
+  if (input == "odometry") params.process_model = OdometryProcessModel{};
+  // The truth is drawn from the built-in noise of both kinds.
+  const CommandNoiseParams command_model_noise;
+  const OdometryNoiseParams odometry_model_noise;
+  const double skid_s = LateralOf(params.process_model).skid_s;
   const Pose2 X_RS(0.05, 0.0, 0.0);
   const Pose2 X_WR0(7.5, 4.0, kPi / 2.0);
   EkfSlam filter(params, mode, X_WR0, X_RS);
@@ -75,19 +79,20 @@ RunErrors Run(CorrectionMode mode, std::uint64_t seed, double reported_variance_
     // drawn from the filter's own noise model.
     record.command = Twist2{0.3, 0.3 / 2.5};
     if (step > 0) {
-      const MotionInput command = CommandInput(record.command, kDt, params.command_noise, record.command);
+      const MotionInput command =
+          CommandInput(record.command, kDt, command_model_noise, record.command);
       const Eigen::Vector2d true_increment(
           command.increment.x() + motion_rng.Gaussian(0.0, std::sqrt(command.covariance(0, 0))),
           command.increment.y() + motion_rng.Gaussian(0.0, std::sqrt(command.covariance(1, 1))));
       // The robot skids outward in the turn as the filter's model says
-      // (EkfParams::lateral_skid_s); the wheel encoders do not see it.
+      // (LateralMotionParams::skid_s); the wheel encoders do not see it.
       truth = PredictPose(truth, true_increment, params.control_point_offset_m, nullptr, nullptr,
-                          params.lateral_skid_s / kDt);
+                          skid_s / kDt);
       // Wheel odometry: the true increment plus noise from the odometry model,
       // composed as Eq. (6) moves R (so OdometryInput recovers it exactly).
       const Eigen::Matrix2d Q = OdometryInput(Pose2(), Pose2(true_increment.x(), 0.0,
                                                              true_increment.y()),
-                                              0.0, params.odometry_noise)
+                                              0.0, odometry_model_noise)
                                     .covariance;
       const double d = true_increment.x() + motion_rng.Gaussian(0.0, std::sqrt(Q(0, 0)));
       const double dth = true_increment.y() + motion_rng.Gaussian(0.0, std::sqrt(Q(1, 1)));

@@ -33,9 +33,9 @@ TEST(EkfSlamTest, PredictsFromCommands) {
   EXPECT_NEAR(filter.X_WR().y, 2.5, 1e-12);
   // The covariance grew from zero along the motion: sigma_v dt per step, the
   // first step also half the command's step from rest.
-  const double sigma_v = params.command_noise.v_noise_std_mps +
-                         params.command_noise.v_noise_fraction * 0.5;
-  const double sigma_first = sigma_v + params.command_noise.change_noise_fraction * 0.5;
+  const CommandNoiseParams& noise = std::get<CommandProcessModel>(params.process_model).noise;
+  const double sigma_v = noise.v_std_mps + noise.v_fraction * 0.5;
+  const double sigma_first = sigma_v + noise.change_fraction * 0.5;
   EXPECT_NEAR(filter.pose_covariance()(1, 1),
               0.01 * (sigma_first * sigma_first + 9 * sigma_v * sigma_v), 1e-12);
   EXPECT_GT(filter.pose_covariance()(0, 0), 0.0);
@@ -47,8 +47,9 @@ TEST(EkfSlamTest, PredictsFromOdometry) {
   // it exactly; with skid, it must add c d dth / dt outward in every step.
   for (const double skid_s : {0.0, 0.01}) {
     EkfParams params;
-    params.input = "odometry";
-    params.lateral_skid_s = skid_s;
+    OdometryProcessModel odometry;
+    odometry.lateral.skid_s = skid_s;
+    params.process_model = odometry;
     params.control_point_offset_m = 0.15;
     const Pose2 X_WR0(3.0, -1.0, 0.4);
     EkfSlam filter(params, CorrectionMode::kSelective, X_WR0, Pose2());
@@ -92,7 +93,7 @@ TEST(EkfSlamTest, OdometryFrameIsArbitrary) {
   // Only increments enter: odometry expressed in another fixed frame (and not
   // starting at the identity) gives the same estimate.
   EkfParams params;
-  params.input = "odometry";
+  params.process_model = OdometryProcessModel{};
   const Pose2 X_WR0(1.0, 2.0, -0.3);
   const Pose2 X_QO(-7.0, 4.0, 2.5);  // some other frame Q
   EkfSlam in_O(params, CorrectionMode::kSelective, X_WR0, Pose2());

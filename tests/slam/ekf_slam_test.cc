@@ -57,29 +57,32 @@ SensorRecord Still() { return SensorRecord{}; }
 TEST(EkfParamsTest, DefaultsAreValidAndBadValuesAreNamed) {
   EXPECT_TRUE(EkfParams().Validate().empty());
   EkfParams params;
-  params.input = "wheels";
+  CommandProcessModel command;
+  command.integration = "rk4";
+  command.noise.v_fraction = -1.0;
+  command.lateral.slip_std_m_per_rad = -0.1;
+  params.process_model = command;
   params.control_point_offset_m = 0.0;
   params.gate_probability = 1.0;
   params.new_feature_probability = 0.5;
   params.max_updates = 0;
-  params.command_noise.v_noise_fraction = -1.0;
-  params.lateral_slip_std_m_per_rad = -0.1;
   const std::vector<ParamProblem> problems = params.Validate();
   std::string keys;
   for (const ParamProblem& problem : problems) keys += problem.key + " ";
-  EXPECT_NE(keys.find("input"), std::string::npos) << keys;
+  EXPECT_NE(keys.find("process_model.integration"), std::string::npos) << keys;
   EXPECT_NE(keys.find("control_point_offset_m"), std::string::npos) << keys;
   EXPECT_NE(keys.find("gate_probability"), std::string::npos) << keys;
   EXPECT_NE(keys.find("new_feature_probability"), std::string::npos) << keys;
   EXPECT_NE(keys.find("max_updates"), std::string::npos) << keys;
-  EXPECT_NE(keys.find("command_noise.v_noise_fraction"), std::string::npos) << keys;
-  EXPECT_NE(keys.find("lateral_slip_std_m_per_rad"), std::string::npos) << keys;
+  EXPECT_NE(keys.find("process_model.noise.v_fraction"), std::string::npos) << keys;
+  EXPECT_NE(keys.find("process_model.lateral.slip_std_m_per_rad"), std::string::npos) << keys;
   EXPECT_THROW(params.ValidateOrThrow(), ParamError);
 }
 
 TEST(EkfParamsTest, MotionIntegrationAndSelectionPolicyAreNamedChoices) {
   EkfParams params;
-  EXPECT_EQ(params.motion_integration, "exact");  // today's behaviour
+  EXPECT_EQ(IntegrationOf(params.process_model), "exact");  // today's behaviour
+  EXPECT_FALSE(PredictsFromOdometry(params.process_model));  // the paper's commands
   EXPECT_EQ(params.selection_policy, "criterion");  // the paper's
   EXPECT_EQ(MotionIntegrationFromName("exact"), MotionIntegration::kExact);
   EXPECT_EQ(MotionIntegrationFromName("euler"), MotionIntegration::kEuler);
@@ -90,13 +93,13 @@ TEST(EkfParamsTest, MotionIntegrationAndSelectionPolicyAreNamedChoices) {
   EXPECT_EQ(SelectionPolicyFromName("determinant"), SelectionPolicy::kDeterminant);
   EXPECT_THROW(MotionIntegrationFromName("rk4"), ParamError);
   EXPECT_THROW(SelectionPolicyFromName("best"), ParamError);
-  params.motion_integration = "rk4";
+  std::get<CommandProcessModel>(params.process_model).integration = "rk4";
   params.selection_policy = "best";
   std::string keys;
   for (const ParamProblem& problem : params.Validate()) keys += problem.key + " ";
-  EXPECT_NE(keys.find("motion_integration"), std::string::npos) << keys;
+  EXPECT_NE(keys.find("process_model.integration"), std::string::npos) << keys;
   EXPECT_NE(keys.find("selection_policy"), std::string::npos) << keys;
-  params.motion_integration = "euler";
+  std::get<CommandProcessModel>(params.process_model).integration = "euler";
   params.selection_policy = "least_informative";
   EXPECT_TRUE(params.Validate().empty());
 }
@@ -112,8 +115,10 @@ TEST(EkfSlamTest, MotionIntegrationKeyChoosesThePrediction) {
   for (const MotionIntegration integration :
        {MotionIntegration::kExact, MotionIntegration::kEuler}) {
     EkfParams params;
-    params.lateral_skid_s = 0.0;
-    params.motion_integration = integration == MotionIntegration::kEuler ? "euler" : "exact";
+    CommandProcessModel command;
+    command.lateral.skid_s = 0.0;
+    command.integration = integration == MotionIntegration::kEuler ? "euler" : "exact";
+    params.process_model = command;
     EkfSlam filter(params, CorrectionMode::kSelective, start, Pose2());
     filter.Step(record, nullptr);
     const Eigen::Vector3d expected =
@@ -125,7 +130,7 @@ TEST(EkfSlamTest, MotionIntegrationKeyChoosesThePrediction) {
   }
   EkfParams exact;
   EkfParams euler;
-  euler.motion_integration = "euler";
+  std::get<CommandProcessModel>(euler.process_model).integration = "euler";
   EkfSlam a(exact, CorrectionMode::kClassical, start, Pose2());
   EkfSlam b(euler, CorrectionMode::kClassical, start, Pose2());
   a.Step(record, nullptr);
@@ -147,12 +152,12 @@ TEST(SlamParamsTest, MergesBothPartsWithPrefixes) {
 
 TEST(EkfSlamTest, ConstructorRejectsInvalidParams) {
   EkfParams params;
-  params.input = "wheels";
+  std::get<CommandProcessModel>(params.process_model).integration = "wheels";
   try {
     EkfSlam filter(params, CorrectionMode::kClassical, Pose2(), Pose2());
     FAIL() << "no exception";
   } catch (const ParamError& error) {
-    EXPECT_NE(std::string(error.what()).find("slam.ekf: input"), std::string::npos)
+    EXPECT_NE(std::string(error.what()).find("slam.ekf: process_model.integration"), std::string::npos)
         << error.what();
     EXPECT_NE(std::string(error.what()).find("wheels"), std::string::npos) << error.what();
   }
@@ -347,9 +352,10 @@ TEST(EkfSlamTest, LineSeenFromTheOtherSideIsAnotherFace) {
     EkfParams params;
     params.gate_line_side = gate_line_side;
     params.new_features_need_match = false;
-    params.command_noise.v_noise_std_mps = 0.1;
-    params.command_noise.v_noise_fraction = 0.0;
-    params.command_noise.change_noise_fraction = 0.0;
+    CommandNoiseParams& noise = std::get<CommandProcessModel>(params.process_model).noise;
+    noise.v_std_mps = 0.1;
+    noise.v_fraction = 0.0;
+    noise.change_fraction = 0.0;
     EkfSlam filter(params, CorrectionMode::kClassical, Pose2(), Pose2());
     ScanFeatures first;
     first.lines.push_back(WallAtTwo(0.0));

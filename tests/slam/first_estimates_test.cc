@@ -54,12 +54,12 @@ double SmallestHeadingVariance(const std::string& jacobians, std::uint64_t seed)
     record.command = Twist2{0.3, 0.3 / 2.5};
     if (step > 0) {
       const MotionInput input =
-          CommandInput(record.command, 0.1, params.command_noise, record.command);
+          CommandInput(record.command, 0.1, CommandNoiseParams{}, record.command);
       const Eigen::Vector2d increment(
           input.increment.x() + rng.Gaussian(0.0, std::sqrt(input.covariance(0, 0))),
           input.increment.y() + rng.Gaussian(0.0, std::sqrt(input.covariance(1, 1))));
       truth = PredictPose(truth, increment, params.control_point_offset_m, nullptr, nullptr,
-                          params.lateral_skid_s / 0.1);
+                          LateralOf(params.process_model).skid_s / 0.1);
     }
     ScanFeatures features;
     const bool scan = step % 2 == 0;

@@ -371,11 +371,11 @@ TEST(MotionModelTest, JacobiansAAndWMatchCentralDifferences) {
 // 20 %, half the command's change.
 CommandNoiseParams TestCommandNoise() {
   CommandNoiseParams noise;
-  noise.v_noise_std_mps = 0.02;
-  noise.v_noise_fraction = 0.1;
-  noise.w_noise_std_radps = 0.01;
-  noise.w_noise_fraction = 0.2;
-  noise.change_noise_fraction = 0.5;
+  noise.v_std_mps = 0.02;
+  noise.v_fraction = 0.1;
+  noise.w_std_radps = 0.01;
+  noise.w_fraction = 0.2;
+  noise.change_fraction = 0.5;
   return noise;
 }
 
@@ -408,18 +408,18 @@ TEST(MotionModelTest, OdometryInputIsTheIncrementInThePreviousFrame) {
   const MotionInput input = OdometryInput(previous, current, 0.2, noise);
   EXPECT_NEAR(input.increment.x(), 0.3, 1e-12);
   EXPECT_NEAR(input.increment.y(), 0.2, 1e-12);
-  const double variance_d = std::pow(noise.distance_noise_std_m, 2) +
-                            std::pow(noise.distance_noise_std_m_per_sqrt_m, 2) * 0.3;
-  const double variance_th = std::pow(noise.heading_noise_std_rad, 2) +
-                             std::pow(noise.heading_noise_std_rad_per_sqrt_m, 2) * 0.3 +
-                             std::pow(noise.heading_noise_std_rad_per_sqrt_rad, 2) * 0.2;
+  const double variance_d = std::pow(noise.distance_std_m, 2) +
+                            std::pow(noise.distance_std_m_per_sqrt_m, 2) * 0.3;
+  const double variance_th = std::pow(noise.heading_std_rad, 2) +
+                             std::pow(noise.heading_std_rad_per_sqrt_m, 2) * 0.3 +
+                             std::pow(noise.heading_std_rad_per_sqrt_rad, 2) * 0.2;
   EXPECT_NEAR(input.covariance(0, 0), variance_d, 1e-15);
   EXPECT_NEAR(input.covariance(1, 1), variance_th, 1e-15);
   // Random walk: two records of half the motion add up to the same variance
   // as one (up to the per-record floors).
   OdometryNoiseParams no_floor = noise;
-  no_floor.distance_noise_std_m = 0.0;
-  no_floor.heading_noise_std_rad = 0.0;
+  no_floor.distance_std_m = 0.0;
+  no_floor.heading_std_rad = 0.0;
   const auto arc = [](const Pose2& from, double d, double dth) {
     const Eigen::Vector3d step = PredictPose(Eigen::Vector3d::Zero(), Eigen::Vector2d(d, dth), 0.2);
     return from * Pose2(step.x(), step.y(), step.z());
