@@ -7,9 +7,9 @@
 #include <optional>
 #include <stdexcept>
 
-#include "app/campaign.h"
-#include "app/import_log.h"
-#include "app/run_config.h"
+#include "app/batch/campaign.h"
+#include "app/jobs/import_log.h"
+#include "app/engine/run_config.h"
 #include "config/config.h"
 #include "realdata/relations.h"
 #include "rundir/csv_writer.h"
