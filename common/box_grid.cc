@@ -1,4 +1,4 @@
-#include "sim/box_grid.h"
+#include "common/box_grid.h"
 
 #include <algorithm>
 #include <cmath>
@@ -6,7 +6,27 @@
 
 #include "common/check.h"
 
-namespace mjslam::sim {
+namespace mjslam {
+namespace {
+
+// Cells at least the boxes' mean size, and at most about 4 per box (1 m
+// without boxes).
+double CellSizeFor(const std::vector<Box2>& boxes) {
+  if (boxes.empty()) return 1.0;
+  Eigen::Vector2d lo = boxes.front().lo;
+  Eigen::Vector2d hi = boxes.front().hi;
+  double size_sum = 0.0;
+  for (const Box2& box : boxes) {
+    lo = lo.cwiseMin(box.lo);
+    hi = hi.cwiseMax(box.hi);
+    size_sum += (box.hi - box.lo).maxCoeff();
+  }
+  const double n = static_cast<double>(boxes.size());
+  const Eigen::Vector2d extent = (hi - lo).cwiseMax(1e-9);
+  return std::max({size_sum / n, std::sqrt(extent.x() * extent.y() / (4.0 * n)), 1e-6});
+}
+
+}  // namespace
 
 double DistanceToBox(const Eigen::Vector2d& p, const Box2& box) {
   const double dx = std::max({box.lo.x() - p.x(), 0.0, p.x() - box.hi.x()});
@@ -20,7 +40,8 @@ BoxGrid::BoxGrid(std::vector<Box2> boxes, double cell_m) : boxes_(std::move(boxe
   Eigen::Vector2d lo = boxes_.front().lo;
   Eigen::Vector2d hi = boxes_.front().hi;
   for (const Box2& box : boxes_) {
-    MJSLAM_CHECK(box.lo.x() <= box.hi.x() && box.lo.y() <= box.hi.y());
+    MJSLAM_CHECK(box.lo.allFinite() && box.hi.allFinite() && box.lo.x() <= box.hi.x() &&
+                 box.lo.y() <= box.hi.y());
     lo = lo.cwiseMin(box.lo);
     hi = hi.cwiseMax(box.hi);
   }
@@ -63,4 +84,36 @@ BoxGrid::BoxGrid(std::vector<Box2> boxes, double cell_m) : boxes_(std::move(boxe
   }
 }
 
-}  // namespace mjslam::sim
+BoxGrid::BoxGrid(std::vector<Box2> boxes) : BoxGrid(boxes, CellSizeFor(boxes)) {}
+
+std::vector<int> BoxGrid::Candidates(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi) const {
+  std::vector<int> found;
+  if (boxes_.empty()) return found;
+  // The cells of lo and hi (as CellOf), clamped to the grid before the cast
+  // to int, so that far or NaN queries stay in range.
+  auto cell = [&](double v, double origin, int n) {
+    const double q = std::floor((v - origin) / limits_.resolution());
+    if (!(q > 0.0)) return 0;  // also NaN
+    return q >= n - 1 ? n - 1 : static_cast<int>(q);
+  };
+  const Eigen::Vector2d& origin = limits_.origin();
+  const int ix0 = cell(lo.x(), origin.x(), limits_.width());
+  const int iy0 = cell(lo.y(), origin.y(), limits_.height());
+  const int ix1 = cell(hi.x(), origin.x(), limits_.width());
+  const int iy1 = cell(hi.y(), origin.y(), limits_.height());
+  for (int iy = iy0; iy <= iy1; ++iy) {
+    for (int ix = ix0; ix <= ix1; ++ix) {
+      for (const int* id = CellBegin(ix, iy); id != CellEnd(ix, iy); ++id) {
+        const Box2& b = boxes_[*id];
+        const bool overlaps = b.lo.x() <= hi.x() && lo.x() <= b.hi.x() && b.lo.y() <= hi.y() &&
+                              lo.y() <= b.hi.y();
+        if (overlaps) found.push_back(*id);
+      }
+    }
+  }
+  std::sort(found.begin(), found.end());
+  found.erase(std::unique(found.begin(), found.end()), found.end());
+  return found;
+}
+
+}  // namespace mjslam

@@ -7,9 +7,9 @@
 
 #include "common/grid2.h"
 
-namespace mjslam::sim {
+namespace mjslam {
 
-/// An axis-aligned box in the floor plane (x, y), metres: lo <= hi.
+/// An axis-aligned box in the plane (x, y), metres: lo <= hi.
 struct Box2 {
   Eigen::Vector2d lo = Eigen::Vector2d::Zero();
   Eigen::Vector2d hi = Eigen::Vector2d::Zero();
@@ -18,22 +18,27 @@ struct Box2 {
 /// Distance in the plane from p to the box (0 inside it), metres.
 double DistanceToBox(const Eigen::Vector2d& p, const Box2& box);
 
-/// A uniform grid of square cells over a set of boxes (the floor-plane
-/// bounding boxes of a world's static geoms): each cell lists the boxes that
-/// overlap it, so that a query near a point, or along a ray traversed cell by
-/// cell (common/grid2.h TraverseSegment), looks only at the boxes there. The
-/// cost of a query grows with what is near the point or the ray, not with
-/// the number of boxes (the uniform grid of Amanatides & Woo, "A fast voxel
-/// traversal algorithm for ray tracing", Eurographics 1987). Immutable once
-/// built; the lists are stored back to back (one index array).
+/// A uniform grid of square cells over a set of boxes (a spatial hash): each
+/// cell lists the boxes that overlap it, so that a query near a point, over a
+/// region, or along a ray traversed cell by cell (common/grid2.h
+/// TraverseSegment), looks only at the boxes there. The cost of a query grows
+/// with what is near the point, the region or the ray, not with the number
+/// of boxes, and tests of n shapes against each other cost about n, not n^2
+/// (the uniform grid of Amanatides & Woo, "A fast voxel traversal algorithm
+/// for ray tracing", Eurographics 1987). Used by the simulator (a world's
+/// static geoms, sim/local_geoms.h) and the ground truth (eval/). Immutable
+/// once built; the lists are stored back to back (one index array).
 class BoxGrid {
  public:
   /// An empty grid (no boxes, no cells).
   BoxGrid() = default;
-  /// Grids `boxes` (ids 0..n-1, in this order) with cells of `cell_m` > 0
-  /// metres over their union. A box is listed in every cell its closure
-  /// touches (a point on a shared side lies in both cells' lists).
+  /// Grids `boxes` (ids 0..n-1, in this order; finite, lo <= hi) with cells
+  /// of `cell_m` > 0 metres over their union. A box is listed in every cell
+  /// its closure touches (a point on a shared side lies in both cells' lists).
   BoxGrid(std::vector<Box2> boxes, double cell_m);
+  /// The same with cells chosen from the boxes: at least their mean size and
+  /// about 4 cells per box at the most.
+  explicit BoxGrid(std::vector<Box2> boxes);
 
   /// The cells' limits (empty when there are no boxes).
   const GridLimits& limits() const { return limits_; }
@@ -52,6 +57,12 @@ class BoxGrid {
   /// (DistanceToBox <= radius_m), in increasing id order.
   template <typename Visit>
   void ForEachNear(const Eigen::Vector2d& p, double radius_m, const Visit& visit) const;
+
+  /// The ids of the boxes whose closed extent overlaps the closed box
+  /// [lo, hi], increasing and without repeats.
+  std::vector<int> Candidates(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi) const;
+  /// Candidates of the single point p.
+  std::vector<int> Candidates(const Eigen::Vector2d& p) const { return Candidates(p, p); }
 
  private:
   GridLimits limits_;
@@ -79,4 +90,4 @@ void BoxGrid::ForEachNear(const Eigen::Vector2d& p, double radius_m, const Visit
   for (const int id : near) visit(id);
 }
 
-}  // namespace mjslam::sim
+}  // namespace mjslam

@@ -1,17 +1,19 @@
 // BoxGrid lists each box in every cell its closure touches, and ForEachNear
-// finds exactly the boxes within a radius (against a brute-force search over
-// seeded random boxes and queries).
+// and Candidates find exactly the boxes within a radius or overlapping a
+// region (against a brute-force search over seeded random boxes and queries).
 
+#include <algorithm>
 #include <cmath>
+#include <random>
 #include <set>
 #include <vector>
 
 #include <gtest/gtest.h>
 
 #include "common/rng.h"
-#include "sim/box_grid.h"
+#include "common/box_grid.h"
 
-namespace mjslam::sim {
+namespace mjslam {
 namespace {
 
 Box2 MakeBox(double x0, double y0, double x1, double y1) {
@@ -80,5 +82,44 @@ TEST(BoxGridTest, AnEmptyGridHasNoCellsAndFindsNothing) {
   EXPECT_EQ(found, 0);
 }
 
+bool Overlaps(const Box2& b, const Eigen::Vector2d& lo, const Eigen::Vector2d& hi) {
+  return b.lo.x() <= hi.x() && lo.x() <= b.hi.x() && b.lo.y() <= hi.y() && lo.y() <= b.hi.y();
+}
+
+TEST(BoxGridTest, CandidatesAreExactlyTheOverlappingBoxes) {
+  std::mt19937_64 rng(7);  // seed printed by the failure message's trace
+  std::uniform_real_distribution<double> position(-50.0, 50.0);
+  std::uniform_real_distribution<double> size(0.0, 3.0);
+  for (const int num : {0, 1, 10, 2000}) {
+    SCOPED_TRACE("seed 7, boxes " + std::to_string(num));
+    std::vector<Box2> boxes;
+    for (int k = 0; k < num; ++k) {
+      const Eigen::Vector2d lo(position(rng), position(rng));
+      // Some long walls and some points among small boxes.
+      const double long_side = k % 50 == 0 ? 40.0 : size(rng);
+      boxes.push_back({lo, lo + Eigen::Vector2d(long_side, k % 7 == 0 ? 0.0 : size(rng))});
+    }
+    // Cells chosen from the boxes, and 1 m cells.
+    for (const BoxGrid& grid : {BoxGrid(boxes), BoxGrid(boxes, 1.0)}) {
+      for (int q = 0; q < 300; ++q) {
+        // Queries inside, across and outside the boxes' extent, and points.
+        const Eigen::Vector2d lo(1.3 * position(rng), 1.3 * position(rng));
+        const Eigen::Vector2d hi = q % 3 == 0 ? lo : Eigen::Vector2d(lo + Eigen::Vector2d(
+                                                     4.0 * size(rng), 4.0 * size(rng)));
+        std::vector<int> expected;
+        for (int k = 0; k < num; ++k) {
+          if (Overlaps(boxes[k], lo, hi)) expected.push_back(k);
+        }
+        ASSERT_EQ(grid.Candidates(lo, hi), expected) << "query " << q;
+      }
+      // A box's own corners find it.
+      for (int k = 0; k < num; ++k) {
+        const std::vector<int> found = grid.Candidates(boxes[k].hi);
+        ASSERT_TRUE(std::binary_search(found.begin(), found.end(), k)) << k;
+      }
+    }
+  }
+}
+
 }  // namespace
-}  // namespace mjslam::sim
+}  // namespace mjslam
