@@ -317,16 +317,12 @@ std::vector<std::string> RunDirectories(const std::vector<std::string>& paths) {
 
 RunMotion ReadRunMotion(const std::string& run_dir) {
   const std::string path = run_dir + "/trajectory.csv";
-  const rundir::CsvTable table = rundir::ReadTrajectoryCsv(path);
-  const int t = table.ColumnIndex("t");
-  const int tx = table.ColumnIndex("true_x");
-  const int ox = table.ColumnIndex("odom_x");
   RunMotion run;
   run.name = run_dir;
-  for (const std::vector<double>& row : table.rows) {
-    run.t_s.push_back(row[t]);
-    run.X_WR_true.emplace_back(row[tx], row[tx + 1], row[tx + 2]);
-    run.X_OR.emplace_back(row[ox], row[ox + 1], row[ox + 2]);
+  for (const rundir::TrajectoryRow& row : rundir::ReadTrajectoryRows(path)) {
+    run.t_s.push_back(row.t_s);
+    run.X_WR_true.push_back(row.X_WR_true);
+    run.X_OR.push_back(row.X_WR_odometry);
   }
   if (!run.X_WR_true.empty() && !std::isfinite(run.X_WR_true.front().x)) {
     throw std::runtime_error(path + ": no true pose (an imported log): calibrate needs runs "

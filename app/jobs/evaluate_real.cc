@@ -9,9 +9,10 @@
 #include <Eigen/Eigenvalues>
 
 #include "app/engine/run_config.h"
-#include "rundir/csv_reader.h"
 #include "rundir/layout.h"
 #include "rundir/manifest.h"
+#include "rundir/map_csv.h"
+#include "rundir/rows.h"
 #include "rundir/run_files.h"
 
 namespace mjslam::app {
@@ -21,24 +22,35 @@ using realdata::Relation;
 using realdata::RelationErrors;
 using realdata::TimedPose;
 
-int Column(const rundir::CsvTable& table, const std::string& name) {
-  for (std::size_t c = 0; c < table.columns.size(); ++c) {
-    if (table.columns[c] == name) return static_cast<int>(c);
+// The filters' columns of a trajectory read back: the filters' estimates
+// are what an imported run is scored on. Throws std::runtime_error naming the
+// file when it has none (a trajectory written by the import, before its
+// replay).
+void RequireFilters(const std::vector<rundir::TrajectoryRow>& trajectory, const std::string& path) {
+  if (trajectory.front().filters.size() != rundir::FilterNames().size()) {
+    throw std::runtime_error(path + ": no filter columns (" + rundir::FilterNames().front() +
+                             "_x, ...)");
   }
-  throw std::runtime_error(table.path + ": no column " + name);
 }
 
-// The poses of the robot centre B in columns `prefix`x, y, th of the rows
-// at `times` (all rows when empty).
-std::vector<TimedPose> PosesOf(const rundir::CsvTable& table, const std::string& prefix,
+// The poses of the robot centre B of the trajectory `track` (0 odometry, 1 +
+// f filter f) at `times` (all rows when empty).
+std::vector<TimedPose> PosesOf(const std::vector<rundir::TrajectoryRow>& trajectory, int track,
                                const std::set<double>& times, const Pose2& X_RB) {
-  const int x = Column(table, prefix + "x");
-  const int t = Column(table, "t");
   std::vector<TimedPose> poses;
-  for (const std::vector<double>& row : table.rows) {
-    if (!times.empty() && times.count(row[t]) == 0) continue;
-    poses.push_back({row[t], Pose2(row[x], row[x + 1], row[x + 2]) * X_RB});
+  for (const rundir::TrajectoryRow& row : trajectory) {
+    if (!times.empty() && times.count(row.t_s) == 0) continue;
+    const Pose2& X_WR = track == 0 ? row.X_WR_odometry : row.filters[track - 1].X_WR;
+    poses.push_back({row.t_s, X_WR * X_RB});
   }
+  return poses;
+}
+
+// The poses of B of the reference.
+std::vector<TimedPose> PosesOf(const std::vector<rundir::ReferenceRow>& reference,
+                               const Pose2& X_RB) {
+  std::vector<TimedPose> poses;
+  for (const rundir::ReferenceRow& row : reference) poses.push_back({row.t_s, row.X_WR * X_RB});
   return poses;
 }
 
@@ -60,16 +72,14 @@ nlohmann::json ToJson(const std::vector<ScoredTrajectory>& scored) {
   return out;
 }
 
-// Counts the rows whose pose covariance of filter `name` is not positive
-// semi-definite, and those where it is singular (the columns hold the upper
-// triangle: symmetric by construction).
-std::pair<int, int> CovarianceDefects(const rundir::CsvTable& table, const std::string& name) {
-  const int c = Column(table, name + "_pxx");
+// Counts the rows whose pose covariance of filter `filter` (in the order of
+// FilterNames()) is not positive semi-definite, and those where it is
+// singular (the file holds the upper triangle: symmetric by construction).
+std::pair<int, int> CovarianceDefects(const std::vector<rundir::TrajectoryRow>& trajectory,
+                                      std::size_t filter) {
   int not_psd = 0, singular = 0;
-  for (const std::vector<double>& row : table.rows) {
-    Eigen::Matrix3d P;
-    P << row[c], row[c + 1], row[c + 2], row[c + 1], row[c + 3], row[c + 4], row[c + 2],
-        row[c + 4], row[c + 5];
+  for (const rundir::TrajectoryRow& row : trajectory) {
+    const Eigen::Matrix3d& P = row.filters[filter].P;
     const Eigen::Vector3d eigenvalues = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(P,
         Eigen::EigenvaluesOnly).eigenvalues();
     const double scale = std::max(eigenvalues.cwiseAbs().maxCoeff(), 1e-300);
@@ -119,19 +129,23 @@ RealEvaluation EvaluateImportedRun(const std::string& run_dir) {
   const nlohmann::json manifest = rundir::ReadManifest(run_dir);
   const RunConfig config = LoadRunConfig(rundir::PathIn(run_dir, rundir::kConfigFile), {});
   const Pose2 X_RB(-config.slam.ekf.control_point_offset_m, 0.0, 0.0);
-  const rundir::CsvTable trajectory = rundir::ReadCsv(rundir::PathIn(run_dir, rundir::kTrajectoryFile));
-  const rundir::CsvTable scans = rundir::ReadCsv(ImportedScansPath(run_dir));
+  const std::string trajectory_path = rundir::PathIn(run_dir, rundir::kTrajectoryFile);
+  const std::vector<rundir::TrajectoryRow> trajectory = rundir::ReadTrajectoryRows(trajectory_path);
+  RequireFilters(trajectory, trajectory_path);
   std::set<double> scan_times;
-  for (const std::vector<double>& row : scans.rows) scan_times.insert(row[0]);
+  for (const rundir::ScanRow& scan : rundir::ReadScanRows(ImportedScansPath(run_dir))) {
+    scan_times.insert(scan.t_s);
+  }
 
   RealEvaluation result;
+  // The trajectories scored, by their track in PosesOf.
   const std::vector<std::string> names = {"classical", "selective", "odometry"};
-  const std::vector<std::string> prefixes = {"classical_", "selective_", "odom_"};
+  const std::vector<int> tracks = {1, 2, 0};
   const std::string reference_path = rundir::PathIn(run_dir, rundir::kReferenceFile);
   const bool has_reference =
       manifest.value("reference", std::string("none")) != "none";
-  rundir::CsvTable reference;
-  if (has_reference) reference = rundir::ReadCsv(reference_path);
+  std::vector<rundir::ReferenceRow> reference;
+  if (has_reference) reference = rundir::ReadReferenceRows(reference_path);
 
   const std::string relations_path = manifest.value("relations_file", std::string());
   if (!relations_path.empty()) {
@@ -143,14 +157,14 @@ RealEvaluation EvaluateImportedRun(const std::string& run_dir) {
     result.tolerance_s = matching.tolerance_s;
     for (std::size_t i = 0; i < names.size(); ++i) {
       result.at_scans.push_back({names[i], realdata::ScoreRelations(
-          relations, PosesOf(trajectory, prefixes[i], scan_times, X_RB), matching)});
+          relations, PosesOf(trajectory, tracks[i], scan_times, X_RB), matching)});
       result.at_records.push_back({names[i], realdata::ScoreRelations(
-          relations, PosesOf(trajectory, prefixes[i], {}, X_RB), matching)});
+          relations, PosesOf(trajectory, tracks[i], {}, X_RB), matching)});
     }
-    const std::vector<TimedPose> at_scans = PosesOf(trajectory, "odom_", scan_times, X_RB);
+    const std::vector<TimedPose> at_scans = PosesOf(trajectory, 0, scan_times, X_RB);
     if (has_reference) {
       result.at_scans.push_back({"reference", realdata::ScoreRelations(
-          relations, PosesOf(reference, "", {}, X_RB), matching)});
+          relations, PosesOf(reference, X_RB), matching)});
     }
     std::set<double> times;
     for (const Relation& r : relations) times.insert({r.t1_s, r.t2_s});
@@ -163,7 +177,7 @@ RealEvaluation EvaluateImportedRun(const std::string& run_dir) {
   }
   if (has_reference) {
     // Relations between scans of the reference `lag` apart, matched exactly.
-    const std::vector<TimedPose> ref = PosesOf(reference, "", {}, X_RB);
+    const std::vector<TimedPose> ref = PosesOf(reference, X_RB);
     const realdata::RelationMatching exact{0.0, 0.0};
     for (const int lag : RealEvaluation::kReferenceLags) {
       const std::size_t step = static_cast<std::size_t>(lag);
@@ -175,17 +189,18 @@ RealEvaluation EvaluateImportedRun(const std::string& run_dir) {
       std::vector<ScoredTrajectory> scored;
       for (std::size_t i = 0; i < names.size(); ++i) {
         scored.push_back({names[i], realdata::ScoreRelations(
-            apart, PosesOf(trajectory, prefixes[i], scan_times, X_RB), exact)});
+            apart, PosesOf(trajectory, tracks[i], scan_times, X_RB), exact)});
       }
       result.vs_reference_lags.push_back(scored);
     }
   }
-  for (const std::string& name : rundir::FilterNames()) {
-    const auto [not_psd, singular] = CovarianceDefects(trajectory, name);
+  for (std::size_t f = 0; f < rundir::FilterNames().size(); ++f) {
+    const auto [not_psd, singular] = CovarianceDefects(trajectory, f);
     result.not_positive_semidefinite.push_back(not_psd);
     result.singular.push_back(singular);
     result.num_features.push_back(static_cast<int>(
-        rundir::ReadCsv(rundir::PathIn(run_dir, rundir::MapFile(name)), {"type"}).rows.size()));
+        rundir::ReadMapCsv(rundir::PathIn(run_dir, rundir::MapFile(rundir::FilterNames()[f])))
+            .size()));
   }
 
   const std::string summary_path = rundir::PathIn(run_dir, rundir::kSummaryFile);

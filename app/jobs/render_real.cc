@@ -10,10 +10,10 @@
 #include "common/interrupt.h"
 #include "renders/plan_canvas.h"
 #include "renders/video_writer.h"
-#include "rundir/csv_reader.h"
 #include "rundir/layout.h"
 #include "rundir/manifest.h"
 #include "rundir/map_csv.h"
+#include "rundir/rows.h"
 
 namespace mjslam::app {
 namespace {
@@ -29,9 +29,10 @@ const Rgb kMapLine = {20, 20, 20};
 const Rgb kCorner = {200, 0, 160};
 const Rgb kRobot = {220, 0, 0};
 
-// One trajectory of the run: its column prefix, colours and map file.
+// One trajectory of the run: which (0 odometry, 1 + f filter f in the order
+// of FilterNames()), its colours and map file.
 struct Track {
-  std::string prefix;
+  int index;
   Rgb path;
   Rgb points;
   std::string map_name;  // empty: no map (odometry)
@@ -39,24 +40,19 @@ struct Track {
 
 const std::vector<Track>& Tracks() {
   static const std::vector<Track> kTracks = {
-      {"odom_", {200, 40, 40}, {235, 160, 160}, ""},
-      {"classical_", {230, 120, 20}, {245, 190, 140}, "classical"},
-      {"selective_", {30, 90, 200}, {150, 180, 235}, "selective"}};
+      {0, {200, 40, 40}, {235, 160, 160}, ""},
+      {1, {230, 120, 20}, {245, 190, 140}, "classical"},
+      {2, {30, 90, 200}, {150, 180, 235}, "selective"}};
   return kTracks;
-}
-
-int Column(const rundir::CsvTable& table, const std::string& name) {
-  const auto it = std::find(table.columns.begin(), table.columns.end(), name);
-  if (it == table.columns.end()) throw std::runtime_error(table.path + ": no column " + name);
-  return static_cast<int>(it - table.columns.begin());
 }
 
 // The files of the run, read once.
 struct RealRun {
   RunConfig config;
   Pose2 X_RS;
-  rundir::CsvTable trajectory;
-  rundir::CsvTable scans;
+  std::vector<rundir::TrajectoryRow> trajectory;
+  std::string scans_path;
+  std::vector<rundir::ScanRow> scans;
   std::vector<Pose2> reference;
   std::map<double, std::size_t> row_at;  // trajectory row of each time
 };
@@ -68,41 +64,44 @@ RealRun ReadRealRun(const std::string& dir) {
       rundir::ReadLaserMount(rundir::PathIn(dir, rundir::kManifestFile));
   if (!mount) throw std::runtime_error(rundir::PathIn(dir, rundir::kManifestFile) + ": no laser_mount");
   run.X_RS = *mount;
-  run.trajectory = rundir::ReadCsv(rundir::PathIn(dir, rundir::kTrajectoryFile));
-  run.scans = rundir::ReadCsv(ImportedScansPath(dir));
-  for (std::size_t i = 0; i < run.trajectory.rows.size(); ++i) {
-    run.row_at[run.trajectory.rows[i][0]] = i;
+  const std::string trajectory_path = rundir::PathIn(dir, rundir::kTrajectoryFile);
+  run.trajectory = rundir::ReadTrajectoryRows(trajectory_path);
+  if (run.trajectory.front().filters.size() != rundir::FilterNames().size()) {
+    throw std::runtime_error(trajectory_path + ": no filter columns (" +
+                             rundir::FilterNames().front() + "_x, ...)");
   }
+  run.scans_path = ImportedScansPath(dir);
+  run.scans = rundir::ReadScanRows(run.scans_path);
+  for (std::size_t i = 0; i < run.trajectory.size(); ++i) run.row_at[run.trajectory[i].t_s] = i;
   const nlohmann::json manifest = rundir::ReadManifest(dir);
   if (manifest.value("reference", std::string("none")) != "none") {
-    for (const auto& row : rundir::ReadCsv(rundir::PathIn(dir, rundir::kReferenceFile)).rows) {
-      run.reference.push_back(Pose2(row[1], row[2], row[3]));
+    for (const rundir::ReferenceRow& row :
+         rundir::ReadReferenceRows(rundir::PathIn(dir, rundir::kReferenceFile))) {
+      run.reference.push_back(row.X_WR);
     }
   }
   return run;
 }
 
-// The pose in columns `prefix`x, y, th of trajectory row `i`.
-Pose2 PoseAt(const RealRun& run, const std::string& prefix, std::size_t i) {
-  const int x = Column(run.trajectory, prefix + "x");
-  const std::vector<double>& row = run.trajectory.rows[i];
-  return Pose2(row[x], row[x + 1], row[x + 2]);
+// The pose of `track` in trajectory row `i`.
+const Pose2& PoseAt(const RealRun& run, const Track& track, std::size_t i) {
+  const rundir::TrajectoryRow& row = run.trajectory[i];
+  return track.index == 0 ? row.X_WR_odometry : row.filters[track.index - 1].X_WR;
 }
 
-// The hit points of scan `k` placed with the pose of `prefix` at its time.
-std::vector<Eigen::Vector2d> ScanPoints(const RealRun& run, const std::string& prefix,
-                                        std::size_t k) {
-  const std::vector<double>& row = run.scans.rows[k];
-  const auto it = run.row_at.find(row[0]);
+// The hit points of scan `k` placed with the pose of `track` at its time.
+std::vector<Eigen::Vector2d> ScanPoints(const RealRun& run, const Track& track, std::size_t k) {
+  const rundir::ScanRow& scan = run.scans[k];
+  const auto it = run.row_at.find(scan.t_s);
   if (it == run.row_at.end()) {
-    throw std::runtime_error(run.scans.path + ": scan at t = " + std::to_string(row[0]) +
+    throw std::runtime_error(run.scans_path + ": scan at t = " + std::to_string(scan.t_s) +
                              " has no trajectory row");
   }
-  const Pose2 X_WS = PoseAt(run, prefix, it->second) * run.X_RS;
+  const Pose2 X_WS = PoseAt(run, track, it->second) * run.X_RS;
   const sim::LaserParams& laser = run.config.laser;
   std::vector<Eigen::Vector2d> points;
   for (int b = 0; b < laser.num_beams; ++b) {
-    const double r = row[rundir::kScanRangesStart + b];
+    const double r = scan.ranges_m[b];
     if (!(r < laser.max_range_m)) continue;
     const double angle = laser.AngleMinRad() + b * laser.AngleIncrementRad();
     points.push_back(X_WS * Eigen::Vector2d(r * std::cos(angle), r * std::sin(angle)));
@@ -114,13 +113,13 @@ std::vector<Eigen::Vector2d> ScanPoints(const RealRun& run, const std::string& p
 // points, so that a few stray long beams do not shrink the building.
 std::pair<Eigen::Vector2d, Eigen::Vector2d> Window(const RealRun& run) {
   std::vector<double> xs, ys;
-  for (std::size_t k = 0; k < run.scans.rows.size(); ++k) {
-    for (const Eigen::Vector2d& p : ScanPoints(run, "selective_", k)) {
+  for (std::size_t k = 0; k < run.scans.size(); ++k) {
+    for (const Eigen::Vector2d& p : ScanPoints(run, Tracks()[2], k)) {
       xs.push_back(p.x());
       ys.push_back(p.y());
     }
   }
-  if (xs.empty()) throw std::runtime_error(run.scans.path + ": no laser returns to draw");
+  if (xs.empty()) throw std::runtime_error(run.scans_path + ": no laser returns to draw");
   auto quantile = [](std::vector<double>* v, double q) {
     const std::size_t i = static_cast<std::size_t>(q * (v->size() - 1));
     std::nth_element(v->begin(), v->begin() + i, v->end());
@@ -145,13 +144,13 @@ void AddScans(const RealRun& run, const Track& track, std::size_t from, std::siz
               PlanCanvas* canvas) {
   for (std::size_t k = from; k < to; ++k) {
     if (k % 256 == 0) ThrowIfInterrupted("render");
-    for (const Eigen::Vector2d& p : ScanPoints(run, track.prefix, k)) canvas->Dot(p, track.points);
+    for (const Eigen::Vector2d& p : ScanPoints(run, track, k)) canvas->Dot(p, track.points);
   }
-  const std::size_t first_row = from == 0 ? 0 : run.row_at.at(run.scans.rows[from - 1][0]);
-  const std::size_t last_row = run.row_at.at(run.scans.rows[to - 1][0]);
+  const std::size_t first_row = from == 0 ? 0 : run.row_at.at(run.scans[from - 1].t_s);
+  const std::size_t last_row = run.row_at.at(run.scans[to - 1].t_s);
   for (std::size_t i = first_row; i + 1 <= last_row; ++i) {
-    canvas->Segment(PoseAt(run, track.prefix, i).translation(),
-                    PoseAt(run, track.prefix, i + 1).translation(), track.path);
+    canvas->Segment(PoseAt(run, track, i).translation(),
+                    PoseAt(run, track, i + 1).translation(), track.path);
   }
 }
 
@@ -183,7 +182,7 @@ renders::Image SideBySide(const std::vector<const renders::Image*>& panels) {
 
 int RenderImportedRun(const std::string& run_dir, const renders::RenderParams& params) {
   const RealRun run = ReadRealRun(run_dir);
-  const std::size_t num_scans = run.scans.rows.size();
+  const std::size_t num_scans = run.scans.size();
   const auto [min, max] = Window(run);
   const int side = params.height - params.height % 2;
   std::vector<PlanCanvas> panels;
@@ -216,8 +215,8 @@ int RenderImportedRun(const std::string& run_dir, const renders::RenderParams& p
       const Track& track = Tracks()[f + 1];
       AddScans(run, track, from, to, &growing[f]);
       frame.push_back(growing[f]);
-      const std::size_t row = run.row_at.at(run.scans.rows[to - 1][0]);
-      frame.back().Dot(PoseAt(run, track.prefix, row).translation(), kRobot, 3);
+      const std::size_t row = run.row_at.at(run.scans[to - 1].t_s);
+      frame.back().Dot(PoseAt(run, track, row).translation(), kRobot, 3);
     }
     video.AddFrame(SideBySide({&frame[0].image(), &frame[1].image()}));
   }

@@ -21,7 +21,6 @@
 #include "app/jobs/scene_frame.h"
 #include "common/interrupt.h"
 #include "renders/scene_renderer.h"
-#include "rundir/csv_reader.h"
 #include "rundir/layout.h"
 #include "rundir/map_csv.h"
 #include "rundir/rows.h"
@@ -35,13 +34,6 @@ namespace mjslam::app {
 namespace {
 
 namespace fs = std::filesystem;
-
-// One filter's columns of trajectory.csv.
-struct FilterColumns {
-  int x, y, th, pxx, pxy, pyy;
-};
-
-using rundir::CsvTable;
 
 // The explorer's sets over time (explorer.csv) as the layers a frame draws.
 struct ExplorerSnapshot {
@@ -127,30 +119,25 @@ class RunPlayback {
       : dir_(dir),
         config_(config),
         min_step_m_(min_step_m),
-        trajectory_(rundir::ReadTrajectoryCsv((dir / rundir::kTrajectoryFile).string())),
-        scans_(rundir::ReadScansCsv((dir / rundir::kScansFile).string())),
+        trajectory_path_((dir / rundir::kTrajectoryFile).string()),
+        trajectory_(rundir::ReadTrajectoryRows(trajectory_path_)),
+        scans_(rundir::ReadScanRows((dir / rundir::kScansFile).string())),
         explorer_(ReadExplorer((dir / rundir::kExplorerFile).string())) {
-    if (trajectory_.rows.empty()) throw std::runtime_error(trajectory_.path + ": no rows to render");
-    t_ = trajectory_.ColumnIndex("t");
-    true_x_ = trajectory_.ColumnIndex("true_x");
-    true_y_ = trajectory_.ColumnIndex("true_y");
-    true_th_ = trajectory_.ColumnIndex("true_th");
     frame_.filters = FilterLayers();
-    for (const renders::FilterLayer& layer : frame_.filters) {
-      const std::string& name = layer.name;
-      filters_.push_back({trajectory_.ColumnIndex(name + "_x"), trajectory_.ColumnIndex(name + "_y"),
-                          trajectory_.ColumnIndex(name + "_th"), trajectory_.ColumnIndex(name + "_pxx"),
-                          trajectory_.ColumnIndex(name + "_pxy"), trajectory_.ColumnIndex(name + "_pyy")});
+    // The layers' filters among the trajectory's (in the order of FilterNames()).
+    const std::vector<std::string>& names = rundir::FilterNames();
+    if (trajectory_.front().filters.size() != names.size()) {
+      throw std::runtime_error(trajectory_path_ + ": no filter columns (" + names.front() + "_x, ...)");
     }
-    scan_t_ = scans_.ColumnIndex("t");
-    scan_x_ = scans_.ColumnIndex("x");
-    scan_y_ = scans_.ColumnIndex("y");
-    scan_th_ = scans_.ColumnIndex("th");
-    scan_r0_ = scans_.ColumnIndex("r0");
+    for (const renders::FilterLayer& layer : frame_.filters) {
+      const auto it = std::find(names.begin(), names.end(), layer.name);
+      if (it == names.end()) throw std::logic_error("no filter named " + layer.name);
+      filter_of_layer_.push_back(static_cast<std::size_t>(it - names.begin()));
+    }
   }
 
   /// Time of the last row, seconds.
-  double end_t() const { return trajectory_.rows.back()[t_]; }
+  double end_t() const { return trajectory_.back().t_s; }
   renders::SceneFrame& frame() { return frame_; }
 
   /// Advances the frame to time T: paths, poses, current scan and explorer sets.
@@ -173,18 +160,18 @@ class RunPlayback {
  private:
   // The trajectory rows up to T: the paths grow, the poses move.
   void AddRowsUpTo(double T) {
-    while (next_row_ < trajectory_.rows.size() && trajectory_.rows[next_row_][t_] <= T + 1e-9) {
-      const std::vector<double>& row = trajectory_.rows[next_row_];
-      const bool last = next_row_ + 1 == trajectory_.rows.size();
-      frame_.t_s = row[t_];
-      frame_.X_WR_true = Pose2(row[true_x_], row[true_y_], row[true_th_]);
-      AppendPathPoint(&frame_.true_path, {row[true_x_], row[true_y_]}, min_step_m_, last);
-      for (std::size_t i = 0; i < filters_.size(); ++i) {
-        const FilterColumns& f = filters_[i];
+    while (next_row_ < trajectory_.size() && trajectory_[next_row_].t_s <= T + 1e-9) {
+      const rundir::TrajectoryRow& row = trajectory_[next_row_];
+      const bool last = next_row_ + 1 == trajectory_.size();
+      frame_.t_s = row.t_s;
+      frame_.X_WR_true = row.X_WR_true;
+      AppendPathPoint(&frame_.true_path, {row.X_WR_true.x, row.X_WR_true.y}, min_step_m_, last);
+      for (std::size_t i = 0; i < filter_of_layer_.size(); ++i) {
+        const rundir::FilterRow& f = row.filters[filter_of_layer_[i]];
         renders::FilterLayer& layer = frame_.filters[i];
-        AppendPathPoint(&layer.path, {row[f.x], row[f.y]}, min_step_m_, last);
-        layer.X_WR = Pose2(row[f.x], row[f.y], row[f.th]);
-        layer.P_xy << row[f.pxx], row[f.pxy], row[f.pxy], row[f.pyy];
+        AppendPathPoint(&layer.path, {f.X_WR.x, f.X_WR.y}, min_step_m_, last);
+        layer.X_WR = f.X_WR;
+        layer.P_xy = f.P.topLeftCorner<2, 2>();
       }
       ++next_row_;
     }
@@ -192,29 +179,27 @@ class RunPlayback {
 
   // The hits of the latest scan at or before T (none before the first).
   void SetScanAt(double T) {
-    const auto scan = std::upper_bound(scans_.rows.begin(), scans_.rows.end(), T + 1e-9,
-                                       [&](double value, const std::vector<double>& row) { return value < row[scan_t_]; });
-    if (scan == scans_.rows.begin()) {
+    const auto scan = std::upper_bound(scans_.begin(), scans_.end(), T + 1e-9,
+                                       [](double value, const rundir::ScanRow& row) { return value < row.t_s; });
+    if (scan == scans_.begin()) {
       frame_.laser_hits.clear();
       return;
     }
-    const std::vector<double>& row = *(scan - 1);
-    frame_.laser_hits = LaserHits(Pose2(row[scan_x_], row[scan_y_], row[scan_th_]),
-                                  std::vector<double>(row.begin() + scan_r0_, row.end()),
-                                  config_.laser.max_range_m, config_.laser.AngleMinRad(),
-                                  config_.laser.AngleIncrementRad());
+    const rundir::ScanRow& row = *(scan - 1);
+    frame_.laser_hits = LaserHits(row.X_WS, row.ranges_m, config_.laser.max_range_m,
+                                  config_.laser.AngleMinRad(), config_.laser.AngleIncrementRad());
   }
 
   fs::path dir_;
   const RunConfig& config_;
   double min_step_m_;
-  CsvTable trajectory_;
-  CsvTable scans_;
+  std::string trajectory_path_;
+  std::vector<rundir::TrajectoryRow> trajectory_;
+  std::vector<rundir::ScanRow> scans_;
   std::vector<ExplorerSnapshot> explorer_;
   renders::SceneFrame frame_;
-  std::vector<FilterColumns> filters_;
-  int t_ = 0, true_x_ = 0, true_y_ = 0, true_th_ = 0;
-  int scan_t_ = 0, scan_x_ = 0, scan_y_ = 0, scan_th_ = 0, scan_r0_ = 0;
+  // The filter (in the order of FilterNames()) of each of frame_.filters.
+  std::vector<std::size_t> filter_of_layer_;
   std::size_t next_row_ = 0;
 };
 
