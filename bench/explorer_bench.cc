@@ -140,8 +140,7 @@ void Run() {
   const std::vector<Wall> walls = Building();
   const std::vector<Pose2> poses = Drive();
   const ExplorerParams params;
-  OccupancyGridSettings settings;
-  OccupancyGrid grid(settings);
+  OccupancyGrid grid(params);
   ClearanceField incremental(ClearanceCapM(params));
   std::printf("Clearance transform per call (every %d scans), CPU ms, same grid, same run\n",
               kScansPerPlan);

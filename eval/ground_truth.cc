@@ -59,8 +59,8 @@ Rectangle MakeRectangle(const WallRectangle& wall, int index, double min_side) {
   return r;
 }
 
-AlignedBox2 BoundsOf(const Rectangle& r, double margin) {
-  AlignedBox2 box{r.corners[0], r.corners[0]};
+Box2 BoundsOf(const Rectangle& r, double margin) {
+  Box2 box{r.corners[0], r.corners[0]};
   for (const Eigen::Vector2d& c : r.corners) {
     box.lo = box.lo.cwiseMin(c);
     box.hi = box.hi.cwiseMax(c);
@@ -104,10 +104,10 @@ std::vector<Piece> BoundaryPieces(const std::vector<Rectangle>& rects,
   const double tol = params.touch_tolerance_m;
   // Bounds grown beyond the clipping margin, so that every rectangle that can
   // cut an edge or cover a point is a candidate of it.
-  std::vector<AlignedBox2> bounds;
+  std::vector<Box2> bounds;
   bounds.reserve(rects.size());
   for (const Rectangle& r : rects) bounds.push_back(BoundsOf(r, 2.0 * tol + 1e-9));
-  const BoxIndex index(bounds);
+  const BoxGrid index(bounds);
   std::vector<Piece> pieces;
   for (std::size_t i = 0; i < rects.size(); ++i) {
     ThrowIfInterrupted("ground truth");
@@ -260,10 +260,10 @@ std::vector<Piece> MergeCollinear(std::vector<Piece> pieces, const GroundTruthPa
 }
 
 std::vector<int> NextSegments(const std::vector<Piece>& segments, double join_m) {
-  std::vector<AlignedBox2> starts;
+  std::vector<Box2> starts;
   starts.reserve(segments.size());
   for (const Piece& s : segments) starts.push_back({s.a, s.a});
-  const BoxIndex index(starts);
+  const BoxGrid index(starts);
   std::vector<int> next(segments.size(), -1);
   const Eigen::Vector2d reach = Eigen::Vector2d::Constant(join_m);
   for (std::size_t i = 0; i < segments.size(); ++i) {
@@ -285,7 +285,7 @@ Grid2<std::uint8_t> OccupiedCells(const std::vector<Rectangle>& rects, const Gri
   for (const Rectangle& r : rects) {
     // The cells whose centres may lie in the rectangle's bounds, one more
     // each side for rounding.
-    const AlignedBox2 box = BoundsOf(r, 0.0);
+    const Box2 box = BoundsOf(r, 0.0);
     const Eigen::Vector2i lo = limits.CellOf(box.lo);
     const Eigen::Vector2i hi = limits.CellOf(box.hi);
     for (int iy = std::max(0, lo.y() - 1); iy <= std::min(limits.height() - 1, hi.y() + 1);

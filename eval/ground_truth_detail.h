@@ -10,7 +10,7 @@
 
 #include <Eigen/Core>
 
-#include "common/box_index.h"
+#include "common/box_grid.h"
 #include "common/grid2.h"
 #include "eval/ground_truth.h"
 
@@ -42,7 +42,7 @@ struct Rectangle {
 Rectangle MakeRectangle(const WallRectangle& wall, int index, double min_side);
 
 /// The axis-aligned bounds of `r` grown by `margin`, metres.
-AlignedBox2 BoundsOf(const Rectangle& r, double margin);
+Box2 BoundsOf(const Rectangle& r, double margin);
 
 /// Parameter interval [t0, t1] of the segment a + t d (t in [0, length], |d| =
 /// 1) inside the rectangle grown by `margin` (slab clipping). False if none.

@@ -10,7 +10,7 @@
 #include <utility>
 
 #include "common/angles.h"
-#include "common/box_index.h"  // AlignedBox2
+#include "common/box_grid.h"  // Box2
 #include "common/check.h"
 #include "common/interrupt.h"
 
@@ -126,7 +126,7 @@ namespace {
 class GaussianTree {
  public:
   struct Node {
-    AlignedBox2 box;
+    Box2 box;
     double max_log_scale = -std::numeric_limits<double>::infinity();
     double max_eigenvalue = 0.0;
     int begin = 0;  // members_[begin .. end)

@@ -14,20 +14,6 @@
 namespace mjslam::explorer {
 namespace {
 
-OccupancyGridSettings GridSettings(const ExplorerParams& p) {
-  OccupancyGridSettings s;
-  s.resolution_m = p.grid_resolution_m;
-  s.max_insert_range_m = p.max_insert_range_m;
-  s.no_return_free_range_m = p.no_return_free_range_m;
-  s.log_odds_hit = p.log_odds_hit;
-  s.log_odds_miss = p.log_odds_miss;
-  s.log_odds_min = p.log_odds_min;
-  s.log_odds_max = p.log_odds_max;
-  s.occupied_threshold = p.occupied_threshold;
-  s.free_threshold = p.free_threshold;
-  return s;
-}
-
 const ExplorerParams& Validated(const ExplorerParams& params, double a_m) {
   params.ValidateOrThrow();
   if (!(a_m > 0.0)) {
@@ -112,7 +98,7 @@ Eigen::Vector2d UnknownDirection(const OccupancyGrid& grid, const Eigen::Vector2
 Explorer::Explorer(const ExplorerParams& params, double a_m)
     : params_(Validated(params, a_m)),
       a_m_(a_m),
-      grid_(GridSettings(params)),
+      grid_(params),
       clearance_(ClearanceCapM(params)),
       tracker_(params, a_m),
       reverse_tracker_(params, a_m) {

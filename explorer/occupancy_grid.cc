@@ -16,9 +16,8 @@ constexpr double kMaxGrazingMarginM = 0.3;
 
 }  // namespace
 
-OccupancyGrid::OccupancyGrid(const OccupancyGridSettings& settings)
-    : settings_(settings),
-      limits_(Eigen::Vector2d::Zero(), settings.resolution_m, 0, 0) {}
+OccupancyGrid::OccupancyGrid(const ExplorerParams& params)
+    : params_(params), limits_(Eigen::Vector2d::Zero(), params.grid_resolution_m, 0, 0) {}
 
 double OccupancyGrid::LogOdds(int ix, int iy) const {
   return Contains(ix, iy) ? log_odds_[Index(ix, iy)] : 0.0;
@@ -34,11 +33,11 @@ double OccupancyGrid::KnownFreeArea() const {
   for (int iy = 0; iy < height(); ++iy) {
     for (int ix = 0; ix < width(); ++ix) count += State(ix, iy) == CellState::kFree;
   }
-  return count * settings_.resolution_m * settings_.resolution_m;
+  return count * params_.grid_resolution_m * params_.grid_resolution_m;
 }
 
 void OccupancyGrid::EnsureCovers(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi) {
-  const double r = settings_.resolution_m;
+  const double r = params_.grid_resolution_m;
   const Eigen::Vector2d origin = limits_.origin();
   const int width = limits_.width();
   const int height = limits_.height();
@@ -99,13 +98,13 @@ void OccupancyGrid::MarkRayFree(const Eigen::Vector2d& from, const Eigen::Vector
 
 void OccupancyGrid::ApplyMarks() {
   for (const int i : touched_) {
-    const double delta = marks_[i] == 2 ? settings_.log_odds_hit : settings_.log_odds_miss;
-    const bool was_occupied = log_odds_[i] >= settings_.occupied_threshold;
-    log_odds_[i] = static_cast<float>(std::clamp(log_odds_[i] + delta, settings_.log_odds_min,
-                                                 settings_.log_odds_max));
+    const double delta = marks_[i] == 2 ? params_.log_odds_hit : params_.log_odds_miss;
+    const bool was_occupied = log_odds_[i] >= params_.occupied_threshold;
+    log_odds_[i] = static_cast<float>(std::clamp(log_odds_[i] + delta, params_.log_odds_min,
+                                                 params_.log_odds_max));
     marks_[i] = 0;
     // The log of occupancy changes (read by ClearanceField).
-    if ((log_odds_[i] >= settings_.occupied_threshold) != was_occupied) {
+    if ((log_odds_[i] >= params_.occupied_threshold) != was_occupied) {
       occupancy_changes_.push_back(limits_.CellOfIndex(i) + lattice_origin_);
     }
   }
@@ -114,7 +113,7 @@ void OccupancyGrid::ApplyMarks() {
 
 OccupancyGrid::BeamFreeSpace OccupancyGrid::FreeSpaceOfBeams(const LaserScan& scan) const {
   const int n = scan.size();
-  const double r_cell = settings_.resolution_m;
+  const double r_cell = params_.grid_resolution_m;
   BeamFreeSpace beams;
   beams.free_range_m.resize(n);
   beams.hit.resize(n);
@@ -123,7 +122,7 @@ OccupancyGrid::BeamFreeSpace OccupancyGrid::FreeSpaceOfBeams(const LaserScan& sc
   };
   for (int i = 0; i < n; ++i) {
     const bool echo = echo_at(i);
-    if (echo && scan.ranges_m[i] <= settings_.max_insert_range_m) {
+    if (echo && scan.ranges_m[i] <= params_.max_insert_range_m) {
       // Stop short of the surface by more at grazing incidence, so that the
       // beam does not run along the row of cells holding the wall and erase
       // it: 0.7 cell across the surface, whose direction comes from the
@@ -147,11 +146,11 @@ OccupancyGrid::BeamFreeSpace OccupancyGrid::FreeSpaceOfBeams(const LaserScan& sc
       beams.free_range_m[i] = std::max(0.0, scan.ranges_m[i] - margin);
       beams.hit[i] = 1;
     } else if (echo) {
-      beams.free_range_m[i] = settings_.max_insert_range_m;
+      beams.free_range_m[i] = params_.max_insert_range_m;
       beams.hit[i] = 0;
     } else {
       beams.free_range_m[i] =
-          std::min(settings_.no_return_free_range_m, settings_.max_insert_range_m);
+          std::min(params_.no_return_free_range_m, params_.max_insert_range_m);
       beams.hit[i] = 0;
     }
   }
@@ -176,7 +175,7 @@ void OccupancyGrid::CoverScan(const LaserScan& scan, const Pose2& X_WS,
 void OccupancyGrid::MarkScanFree(const LaserScan& scan, const Pose2& X_WS,
                                  const BeamFreeSpace& beams) {
   const int n = scan.size();
-  const double r_cell = settings_.resolution_m;
+  const double r_cell = params_.grid_resolution_m;
   const Eigen::Vector2d p_WS = X_WS.translation();
   const std::vector<double>& free_range = beams.free_range_m;
   for (int i = 0; i < n; ++i) {

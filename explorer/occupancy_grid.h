@@ -8,22 +8,9 @@
 #include "common/grid2.h"
 #include "common/laser_scan.h"
 #include "common/pose2.h"
+#include "explorer/explorer_params.h"
 
 namespace mjslam::explorer {
-
-/// Settings of the occupancy grid (a part of ExplorerParams, see
-/// explorer/explorer_params.h for the meaning and units of each field).
-struct OccupancyGridSettings {
-  double resolution_m = 0.05;
-  double max_insert_range_m = 8.0;
-  double no_return_free_range_m = 4.0;
-  double log_odds_hit = 0.85;
-  double log_odds_miss = -0.4;
-  double log_odds_min = -4.0;
-  double log_odds_max = 4.0;
-  double occupied_threshold = 0.6;
-  double free_threshold = -0.3;
-};
 
 /// State of one cell as the planner sees it.
 enum class CellState : std::uint8_t { kUnknown = 0, kFree = 1, kOccupied = 2 };
@@ -44,8 +31,10 @@ enum class CellState : std::uint8_t { kUnknown = 0, kFree = 1, kOccupied = 2 };
 /// dark or distant surfaces, so "nothing up to 30 m" is not trusted).
 class OccupancyGrid {
  public:
-  /// `settings` must be valid (ExplorerParams::Validate checks them).
-  explicit OccupancyGrid(const OccupancyGridSettings& settings);
+  /// The grid of the explorer's settings under "Occupancy grid" in
+  /// `params` (grid_resolution_m, the ranges, the log-odds and thresholds),
+  /// which must be valid (ExplorerParams::ValidateOrThrow checks them).
+  explicit OccupancyGrid(const ExplorerParams& params);
 
   /// Inserts one scan taken with the laser frame S at `X_WS`.
   void InsertScan(const LaserScan& scan, const Pose2& X_WS);
@@ -58,7 +47,7 @@ class OccupancyGrid {
   /// The grid's limits (no cells before the first insertion).
   const GridLimits& limits() const { return limits_; }
   /// Cell size, metres.
-  double resolution() const { return settings_.resolution_m; }
+  double resolution() const { return params_.grid_resolution_m; }
   /// Grid size in cells (0 before the first insertion).
   int width() const { return limits_.width(); }
   int height() const { return limits_.height(); }
@@ -80,8 +69,8 @@ class OccupancyGrid {
   CellState State(int ix, int iy) const {
     if (!Contains(ix, iy)) return CellState::kUnknown;
     const double l = log_odds_[Index(ix, iy)];
-    if (l >= settings_.occupied_threshold) return CellState::kOccupied;
-    if (l <= settings_.free_threshold) return CellState::kFree;
+    if (l >= params_.occupied_threshold) return CellState::kOccupied;
+    if (l <= params_.free_threshold) return CellState::kFree;
     return CellState::kUnknown;
   }
   /// State of the cell containing `p_W`.
@@ -129,7 +118,7 @@ class OccupancyGrid {
   // Applies the marks of this scan and clears them.
   void ApplyMarks();
 
-  OccupancyGridSettings settings_;
+  ExplorerParams params_;
   GridLimits limits_;
   std::vector<float> log_odds_;
   // Per-scan update marks: 0 none, 1 free, 2 occupied; `touched_` lists the

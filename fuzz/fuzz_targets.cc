@@ -7,13 +7,13 @@
 #include <optional>
 #include <stdexcept>
 
-#include "app/campaign.h"
-#include "app/import_log.h"
-#include "app/run_config.h"
+#include "app/batch/campaign.h"
+#include "app/jobs/import_log.h"
+#include "app/engine/run_config.h"
 #include "config/config.h"
 #include "realdata/relations.h"
 #include "rundir/csv_writer.h"
-#include "sim/box_grid.h"
+#include "common/box_grid.h"
 #include "sim/scene.h"
 #include "rundir/csv_reader.h"
 #include "rundir/layout.h"
@@ -189,7 +189,7 @@ void ReadCampaign(std::string_view input, const std::string& scratch_path) {
 // World geometry: one footprint per line, "box X Y YAW_DEG HX HY" or "disc X
 // Y R", and "start X Y". Checked as a world's are (sim::CheckWorldExtent,
 // sim.max_world_extent_m = 500), then gridded as the simulator grids them
-// (sim::BoxGrid, 1 m cells); accepted: a grid of bounded size holding every box.
+// (BoxGrid of common/box_grid.h, 1 m cells); accepted: a grid of bounded size holding every box.
 void ReadWorld(std::string_view input, const std::string& /*scratch_path*/) {
   std::istringstream lines{std::string(input)};
   std::vector<sim::ObstacleFootprint> obstacles;
@@ -221,9 +221,9 @@ void ReadWorld(std::string_view input, const std::string& /*scratch_path*/) {
   } catch (const std::runtime_error&) {
     return;  // refused, with a message
   }
-  std::vector<sim::Box2> boxes;
+  std::vector<Box2> boxes;
   for (const sim::ObstacleFootprint& o : obstacles) {
-    sim::Box2 box;
+    Box2 box;
     box.lo = box.hi = o.X_WO.translation();
     if (o.shape == sim::ObstacleFootprint::Shape::kRectangle) {
       for (const Eigen::Vector2d& corner : sim::RectangleCorners(o)) {
@@ -237,7 +237,7 @@ void ReadWorld(std::string_view input, const std::string& /*scratch_path*/) {
     Expect(box.lo.allFinite() && box.hi.allFinite(), "an accepted footprint not finite");
     boxes.push_back(box);
   }
-  const sim::BoxGrid grid(boxes, 1.0);
+  const BoxGrid grid(boxes, 1.0);
   const double side = kMaxExtentM + 4.0;
   Expect(static_cast<double>(grid.limits().num_cells()) <= side * side, "a grid beyond the extent");
   for (int id = 0; id < grid.num_boxes(); ++id) {

@@ -31,7 +31,7 @@ struct Target {
 /// writing; accepted: scans, a bounded skip report, a finite offset),
 /// campaign (LoadCampaign and CampaignCells within 1000 cells; accepted:
 /// distinct folders inside the campaign, campaign.csv of whole rows), world
-/// (footprint lines through sim::CheckWorldExtent and sim::BoxGrid;
+/// (footprint lines through sim::CheckWorldExtent and BoxGrid;
 /// accepted: a grid of bounded size holding every box).
 /// A check of an accepted input that fails throws std::logic_error.
 const std::vector<Target>& Targets();

@@ -15,7 +15,7 @@ using Rgb = std::array<std::uint8_t, 3>;
 /// A plan view drawn without OpenGL: points and segments of the world plane
 /// onto an image, world x to the right and y up, at one scale for both axes
 /// (the window is fitted inside the image and centred). For what has no
-/// MuJoCo world to render, such as a real log (app/render_real.h).
+/// MuJoCo world to render, such as a real log (app/jobs/render_real.h).
 class PlanCanvas {
  public:
   /// A white image of `width` x `height` pixels showing at least the window

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <limits>
+#include <map>
 #include <stdexcept>
 #include <string_view>
 #include <utility>
@@ -121,6 +123,140 @@ CsvTable ReadScansCsv(const std::string& path) {
   const int num_ranges = static_cast<int>(table.columns.size()) - kScanRangesStart;
   CheckValuesInRange(table, kScanRangesStart, num_ranges, 0.0, kMaxRecordedCoordinateM);
   return table;
+}
+
+namespace {
+
+// Checks that `table` has no columns after `expected` (which it starts with).
+void CheckNoMoreColumns(const CsvTable& table, const std::vector<std::string>& expected) {
+  if (table.columns.size() == expected.size()) return;
+  throw std::runtime_error(table.path + ": column " + table.columns[expected.size()] +
+                           ": expected no column after " + expected.back() + " (got " +
+                           std::to_string(table.columns.size()) + " columns, expected " +
+                           std::to_string(expected.size()) + ")");
+}
+
+// The value of column `c` of row `r` as a whole number in [0, hi].
+int WholeNumber(const CsvTable& table, std::size_t r, int c, double hi) {
+  const double value = table.rows[r][c];
+  if (!(value >= 0.0 && value <= hi && std::floor(value) == value)) {
+    throw std::runtime_error(table.path + ":" + std::to_string(table.lines[r]) + ": column " +
+                             table.columns[c] + ": expected a whole number in [0, " +
+                             FormatDouble(hi) + "] (got " + FormatDouble(value) + ")");
+  }
+  return static_cast<int>(value);
+}
+
+// The pose in columns c, c + 1, c + 2 of `row`.
+Pose2 PoseAt(const std::vector<double>& row, int c) { return Pose2(row[c], row[c + 1], row[c + 2]); }
+
+}  // namespace
+
+std::vector<TrajectoryRow> ReadTrajectoryRows(const std::string& path) {
+  const CsvTable table = ReadTrajectoryCsv(path);
+  // The columns after the recorded ones, by name: each known, none twice.
+  const std::size_t num_recorded = RecordedTrajectoryColumns().size();
+  std::vector<std::string> known = {"explored"};
+  for (const std::string& name : FilterNames()) {
+    for (const std::string& column : FilterColumns(name)) known.push_back(column);
+  }
+  std::map<std::string, int> index;
+  for (std::size_t c = num_recorded; c < table.columns.size(); ++c) {
+    const std::string& column = table.columns[c];
+    if (std::find(known.begin(), known.end(), column) == known.end()) {
+      throw std::runtime_error(path + ": column " + column + ": not a column of " +
+                               std::string(kTrajectoryFile) + " (docs/run_directory.md)");
+    }
+    if (!index.emplace(column, static_cast<int>(c)).second) {
+      throw std::runtime_error(path + ": column " + column + ": twice");
+    }
+  }
+  const bool has_filters = index.size() > index.count("explored");
+  // Column `column`: its index; -1 when it is absent and `optional`.
+  auto column_of = [&](const std::string& column, bool optional) {
+    const auto it = index.find(column);
+    if (it != index.end()) return it->second;
+    if (optional) return -1;
+    throw std::runtime_error(path + ": no column " + column + " (the filters' columns are " +
+                             "all there or none; only explored, *_period, *_open_loop, *_nees " +
+                             "and *_processed may be missing, as in older runs)");
+  };
+  const int explored = column_of("explored", true);
+  // Each filter's column of each of FilterColumnSuffixes(), by suffix.
+  const std::vector<std::string>& suffixes = FilterColumnSuffixes();
+  const std::vector<std::string> optional = {"period", "open_loop", "nees", "processed"};
+  std::vector<std::map<std::string, int>> filters;
+  if (has_filters) {
+    for (const std::string& name : FilterNames()) {
+      filters.emplace_back();
+      for (const std::string& suffix : suffixes) {
+        const bool may_miss = std::find(optional.begin(), optional.end(), suffix) != optional.end();
+        filters.back()[suffix] = column_of(name + "_" + suffix, may_miss);
+      }
+    }
+  }
+  constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+  std::vector<TrajectoryRow> rows(table.rows.size());
+  for (std::size_t r = 0; r < table.rows.size(); ++r) {
+    const std::vector<double>& v = table.rows[r];
+    TrajectoryRow& row = rows[r];
+    // The recorded columns, in their order (checked by ReadTrajectoryCsv).
+    row.t_s = v[0];
+    row.X_WR_true = PoseAt(v, 1);
+    row.X_WR_odometry = PoseAt(v, 4);
+    row.command = {v[7], v[8]};
+    row.explored = explored >= 0 ? v[explored] : kNaN;
+    for (const std::map<std::string, int>& columns : filters) {
+      // The value of column `suffix`; NaN when it is absent.
+      auto value = [&](const char* suffix) {
+        const int c = columns.at(suffix);
+        return c >= 0 ? v[c] : kNaN;
+      };
+      auto count = [&](const char* suffix) { return WholeNumber(table, r, columns.at(suffix), 1e9); };
+      FilterRow filter;
+      filter.X_WR = Pose2(value("x"), value("y"), value("th"));
+      filter.P << value("pxx"), value("pxy"), value("pxth"), value("pxy"), value("pyy"),
+          value("pyth"), value("pxth"), value("pyth"), value("pthth");
+      filter.num_features = count("nfeat");
+      filter.num_matched = count("nmatched");
+      filter.num_updated = count("nupdated");
+      filter.processing_us = value("us");
+      filter.period_s = value("period");
+      filter.open_loop_s = value("open_loop");
+      filter.nees = value("nees");
+      const int processed = columns.at("processed");
+      filter.processed = processed < 0 || WholeNumber(table, r, processed, 1.0) == 1;
+      row.filters.push_back(filter);
+    }
+  }
+  return rows;
+}
+
+std::vector<ScanRow> ReadScanRows(const std::string& path) {
+  const CsvTable table = ReadScansCsv(path);
+  std::vector<ScanRow> rows(table.rows.size());
+  for (std::size_t r = 0; r < table.rows.size(); ++r) {
+    const std::vector<double>& v = table.rows[r];
+    rows[r].t_s = v[0];
+    rows[r].X_WS = PoseAt(v, 1);
+    rows[r].ranges_m.assign(v.begin() + kScanRangesStart, v.end());
+  }
+  return rows;
+}
+
+std::vector<ReferenceRow> ReadReferenceRows(const std::string& path) {
+  const CsvTable table = ReadCsv(path);
+  const std::vector<std::string> expected = ReferenceColumns();
+  CheckLeadingColumns(table, expected);
+  CheckNoMoreColumns(table, expected);
+  CheckIncreasingTimes(table, 0);
+  std::vector<ReferenceRow> rows(table.rows.size());
+  for (std::size_t r = 0; r < table.rows.size(); ++r) {
+    rows[r].t_s = table.rows[r][0];
+    rows[r].X_WR = PoseAt(table.rows[r], 1);
+  }
+  return rows;
 }
 
 std::vector<ExplorerSnapshot> ReadExplorerCsv(const std::string& path) {

@@ -95,6 +95,49 @@ CsvTable ReadTrajectoryCsv(const std::string& path);
 /// problem.
 CsvTable ReadScansCsv(const std::string& path);
 
+/// Reads a trajectory.csv into its rows, the inverse of AddTrajectoryRow:
+/// the checks of ReadTrajectoryCsv (the recorded columns first, in order),
+/// then the other columns of TrajectoryColumns() by name, in any order, none
+/// twice and no other. The filters' columns are there for every filter or
+/// for none (a recording: `filters` empty); "explored" and each filter's
+/// "_period", "_open_loop", "_nees" and "_processed" may be missing (runs
+/// from before them): NaN, and processed true. Poses go through Pose2's
+/// constructor (angles wrapped), P is the symmetric matrix of its upper
+/// triangle, an empty field is NaN. Throws std::runtime_error naming the
+/// file, line, column and value of the first problem (a column unknown,
+/// twice or missing, a count that is not a whole number in [0, 1e9], a
+/// processed flag not 0 or 1).
+std::vector<TrajectoryRow> ReadTrajectoryRows(const std::string& path);
+
+/// One row of scans.csv.
+struct ScanRow {
+  /// Time of the scan, seconds.
+  double t_s = 0.0;
+  /// True pose of the laser S in W (NaN in a recording without truth).
+  Pose2 X_WS;
+  /// The ranges, metres, in the order of the beams.
+  std::vector<double> ranges_m;
+};
+
+/// Reads a scans.csv into its rows, with the checks of ReadScansCsv (the
+/// pose through Pose2's constructor). Throws std::runtime_error naming the
+/// file, line, column and value of the first problem.
+std::vector<ScanRow> ReadScanRows(const std::string& path);
+
+/// One row of reference.csv: the pose of R that an imported log carries at
+/// one of its scans.
+struct ReferenceRow {
+  /// Time of the scan, seconds.
+  double t_s = 0.0;
+  Pose2 X_WR;
+};
+
+/// Reads a reference.csv (ReferenceColumns(), exactly; times finite and
+/// increasing; the pose through Pose2's constructor). Throws
+/// std::runtime_error naming the file, line, column and value of the first
+/// problem.
+std::vector<ReferenceRow> ReadReferenceRows(const std::string& path);
+
 /// Reads explorer.csv into its snapshots, in the order of time (rows of one
 /// time form one snapshot; path points sorted by index). A missing file
 /// gives none. Throws std::runtime_error naming the file and line of an

@@ -11,7 +11,7 @@
 
 #include <mujoco/mujoco.h>
 
-#include "sim/box_grid.h"
+#include "common/box_grid.h"
 #include "sim/scene_model.h"
 
 namespace mjslam::sim::internal {

@@ -572,7 +572,7 @@ class Run:
 
     def errors(self, name):
         """(N, 3) estimate - true pose of filter `name` per step (heading wrapped, wrap_angle),
-        as mjslam evaluate compares them (app/evaluate.cc): on a step the filter skipped
+        as mjslam evaluate compares them (app/jobs/evaluate.cc): on a step the filter skipped
         (slam.timing realtime) it holds the estimate of its last processed step, compared with
         that step's true pose; on every other step, with the step's own."""
         processed = self.processed(name)

@@ -64,7 +64,7 @@ std::vector<float> BruteForce(const OccupancyGrid& grid) {
 TEST(ClearanceFieldTest, IncrementalEqualsRecomputation) {
   for (const std::uint64_t seed : {1u, 2u, 3u}) {
     Rng rng(seed);
-    OccupancyGrid grid{OccupancyGridSettings{}};
+    OccupancyGrid grid{ExplorerParams{}};
     ClearanceField incremental(kCapM);
     Pose2 X_WS(0.0, 0.0, 0.0);
     int changes_seen = 0;
@@ -96,7 +96,7 @@ TEST(ClearanceFieldTest, IncrementalEqualsRecomputation) {
 // tiles within the cap of that scan, not the grid.
 TEST(ClearanceFieldTest, UpdateCostIsLocal) {
   Rng rng(7);
-  OccupancyGrid grid{OccupancyGridSettings{}};
+  OccupancyGrid grid{ExplorerParams{}};
   ClearanceField field(kCapM);
   for (int k = 0; k < 40; ++k) {
     grid.InsertScan(RandomScan(&rng), Pose2(0.5 * k, 0.3 * k, 0.7 * k));

@@ -73,7 +73,7 @@ OccupancyGrid CorridorGrid() {
   std::vector<testing::Wall> walls = {{{0, 0}, {8, 0}}, {{0, 2}, {8, 2}}, {{0, 0}, {0, 2}}};
   testing::KinematicSim::Config config;
   config.max_range_m = 4.0;
-  OccupancyGrid grid{OccupancyGridSettings{}};
+  OccupancyGrid grid{ExplorerParams{}};
   for (const double th : {0.0, kPi}) {
     testing::KinematicSim sim(walls, Pose2(1.5, 1.0, th), config);
     grid.InsertScan(sim.Scan(0.0), sim.X_WR() * config.X_RS);
@@ -150,7 +150,7 @@ TEST(FrontiersTest, GainEqualsCountingEverySample) {
   }
   testing::KinematicSim::Config config;
   config.max_range_m = 5.0;
-  OccupancyGrid grid{OccupancyGridSettings{}};
+  OccupancyGrid grid{ExplorerParams{}};
   for (int i = 0; i < 4; ++i) {
     testing::KinematicSim sim(walls, Pose2(8.0 * rng.Uniform(), 6.0 * rng.Uniform(),
                                            2.0 * kPi * rng.Uniform()), config);

@@ -20,7 +20,7 @@ LaserScan UniformScan(int n, double range, bool echo, double max_range) {
 }
 
 TEST(OccupancyGridTest, EchoIsOccupiedAndBeamIsFree) {
-  OccupancyGrid grid{OccupancyGridSettings{}};
+  OccupancyGrid grid{ExplorerParams{}};
   LaserScan scan = UniformScan(181, 2.0, true, 30.0);
   grid.InsertScan(scan, Pose2(1.0, 1.0, 0.0));
   // Straight ahead: free up to the echo at 2 m, occupied there, unknown behind.
@@ -38,9 +38,9 @@ TEST(OccupancyGridTest, EchoIsOccupiedAndBeamIsFree) {
 }
 
 TEST(OccupancyGridTest, NoReturnClearsOnlyUpToItsRange) {
-  OccupancyGridSettings settings;
-  settings.no_return_free_range_m = 3.0;
-  OccupancyGrid grid(settings);
+  ExplorerParams params;
+  params.no_return_free_range_m = 3.0;
+  OccupancyGrid grid(params);
   grid.InsertScan(UniformScan(181, 0.0, false, 30.0), Pose2(0.0, 0.0, 0.0));
   EXPECT_EQ(grid.StateAt({2.8, 0.0}), CellState::kFree);
   EXPECT_EQ(grid.StateAt({3.2, 0.0}), CellState::kUnknown);
@@ -54,16 +54,16 @@ TEST(OccupancyGridTest, NoReturnClearsOnlyUpToItsRange) {
 }
 
 TEST(OccupancyGridTest, FarEchoOnlyClearsUpToInsertRange) {
-  OccupancyGridSettings settings;
-  settings.max_insert_range_m = 5.0;
-  OccupancyGrid grid(settings);
+  ExplorerParams params;
+  params.max_insert_range_m = 5.0;
+  OccupancyGrid grid(params);
   grid.InsertScan(UniformScan(181, 7.0, true, 30.0), Pose2(0.0, 0.0, 0.0));
   EXPECT_EQ(grid.StateAt({4.8, 0.0}), CellState::kFree);
   EXPECT_EQ(grid.StateAt({7.0, 0.0}), CellState::kUnknown);
 }
 
 TEST(OccupancyGridTest, RepeatedMissesOverrideOneHit) {
-  OccupancyGrid grid{OccupancyGridSettings{}};
+  OccupancyGrid grid{ExplorerParams{}};
   // One scan sees a wall at 2 m; later scans see through it to 4 m.
   grid.InsertScan(UniformScan(181, 2.0, true, 30.0), Pose2(0.0, 0.0, 0.0));
   ASSERT_EQ(grid.StateAt({2.0, 0.0}), CellState::kOccupied);
@@ -75,7 +75,7 @@ TEST(OccupancyGridTest, RepeatedMissesOverrideOneHit) {
 }
 
 TEST(OccupancyGridTest, GrowsKeepingCellsInPlace) {
-  OccupancyGrid grid{OccupancyGridSettings{}};
+  OccupancyGrid grid{ExplorerParams{}};
   grid.InsertScan(UniformScan(181, 2.0, true, 30.0), Pose2(0.0, 0.0, 0.0));
   const int width = grid.width();
   // A scan far away grows the grid; the first scan's cells keep their state.
@@ -89,7 +89,7 @@ TEST(OccupancyGridTest, GrowsKeepingCellsInPlace) {
 TEST(OccupancyGridTest, RoomWallsAreOccupiedAndInsideFree) {
   // Exact scans from the middle of a 6 x 4 m room, four headings.
   const std::vector<testing::Wall> walls = testing::Box(0.0, 0.0, 6.0, 4.0);
-  OccupancyGrid grid{OccupancyGridSettings{}};
+  OccupancyGrid grid{ExplorerParams{}};
   testing::KinematicSim::Config config;
   for (int k = 0; k < 4; ++k) {
     testing::KinematicSim sim(walls, Pose2(3.0, 2.0, k * 0.5 * kPi), config);

@@ -21,7 +21,7 @@ std::vector<Wall> LCorridor() {
 }
 
 OccupancyGrid MappedLCorridor() {
-  OccupancyGrid grid{OccupancyGridSettings{}};
+  OccupancyGrid grid{ExplorerParams{}};
   testing::KinematicSim::Config config;
   const Pose2 views[] = {Pose2(1.0, 1.0, 0.0), Pose2(1.0, 1.0, kPi), Pose2(5.0, 1.0, 0.5 * kPi),
                          Pose2(5.0, 1.0, -0.5 * kPi), Pose2(5.0, 6.0, 0.5 * kPi),
@@ -152,7 +152,7 @@ std::vector<Wall> WallWithDoor() {
 TEST(PathPlannerTest, PathThroughADoorDoesNotStartWithATinyLeg) {
   const ExplorerParams params;
   const std::vector<Wall> walls = WallWithDoor();
-  OccupancyGrid grid{OccupancyGridSettings{}};
+  OccupancyGrid grid{ExplorerParams{}};
   testing::KinematicSim::Config config;
   config.max_range_m = 10.0;
   for (const Pose2& view : {Pose2(2.3, 1.5, 0.5 * kPi), Pose2(2.3, 1.5, -0.5 * kPi),
@@ -218,7 +218,7 @@ OccupancyGrid MappedCorridor(double length_m) {
                                    {{length_m, 0}, {length_m, 2}},
                                    {{length_m, 2}, {0, 2}},
                                    {{0, 2}, {0, 0}}};
-  OccupancyGrid grid{OccupancyGridSettings{}};
+  OccupancyGrid grid{ExplorerParams{}};
   testing::KinematicSim::Config config;
   for (double x = 1.0; x < length_m; x += 1.0) {
     for (const double heading : {0.0, kPi}) {

@@ -12,8 +12,8 @@
 
 #include <gtest/gtest.h>
 
-#include "app/run_config.h"
-#include "app/sweep.h"
+#include "app/engine/run_config.h"
+#include "app/batch/sweep.h"
 #include "rundir/summary.h"
 #include "tests/integration/run_helpers.h"
 

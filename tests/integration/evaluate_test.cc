@@ -8,9 +8,9 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "app/evaluate.h"
-#include "app/run_config.h"
-#include "app/sweep.h"
+#include "app/jobs/evaluate.h"
+#include "app/engine/run_config.h"
+#include "app/batch/sweep.h"
 #include "rundir/map_csv.h"
 #include "tests/integration/run_helpers.h"
 #include "rundir/layout.h"

@@ -6,8 +6,8 @@
 
 #include <gtest/gtest.h>
 
-#include "app/evaluate.h"
-#include "app/run_config.h"
+#include "app/jobs/evaluate.h"
+#include "app/engine/run_config.h"
 #include "common/segments.h"
 #include "sim/obstacles.h"
 #include "sim/scene.h"

@@ -7,7 +7,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "app/run_config.h"
+#include "app/engine/run_config.h"
 #include "rundir/layout.h"
 #include "rundir/summary.h"
 #include "tests/integration/run_helpers.h"

@@ -11,9 +11,9 @@
 
 #include <gtest/gtest.h>
 
-#include "app/evaluate_real.h"
-#include "app/import_log.h"
-#include "app/run_config.h"
+#include "app/jobs/evaluate_real.h"
+#include "app/jobs/import_log.h"
+#include "app/engine/run_config.h"
 
 namespace mjslam::app {
 namespace {

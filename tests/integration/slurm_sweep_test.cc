@@ -14,9 +14,9 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "app/run_config.h"
-#include "app/slurm.h"
-#include "app/sweep.h"
+#include "app/engine/run_config.h"
+#include "app/batch/slurm.h"
+#include "app/batch/sweep.h"
 #include "rundir/csv_reader.h"
 #include "rundir/csv_writer.h"
 #include "rundir/layout.h"

@@ -25,7 +25,7 @@ TEST(SimLayeringTest, OnlyTheMujocoAdapterIncludesMujoco) {
        {"sim/sim_params.h", "sim/sim_params.cc", "sim/diff_drive.h", "sim/diff_drive.cc",
         "sim/laser_noise.h", "sim/laser_noise.cc", "sim/laser_footprint.h", "sim/wheel_odometry.h",
         "sim/wheel_odometry.cc", "sim/obstacles.h", "sim/obstacles.cc", "sim/simulator.h",
-        "sim/scene.h", "sim/mujoco_errors.h", "sim/box_grid.h", "sim/box_grid.cc"}) {
+        "sim/scene.h", "sim/mujoco_errors.h"}) {
     const std::string text = ReadSource(file);
     EXPECT_EQ(text.find("#include <mujoco"), std::string::npos) << file;
     EXPECT_EQ(text.find("mjModel"), std::string::npos) << file;

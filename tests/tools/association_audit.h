@@ -17,8 +17,8 @@
 
 #include <Eigen/Cholesky>
 
-#include "app/evaluate.h"
-#include "app/run_config.h"
+#include "app/jobs/evaluate.h"
+#include "app/engine/run_config.h"
 #include "common/angles.h"
 #include "rundir/csv_reader.h"
 #include "rundir/recording.h"
@@ -108,7 +108,7 @@ inline int TrueFace(const FeatureMap& truth, double alpha, const Eigen::Vector2d
 }
 
 // The record of recorded step i as the closed loop builds it in a replay
-// (app/closed_loop.cc, ReadRecording); `applied` is the command of step i-1.
+// (app/engine/closed_loop.cc, ReadRecording); `applied` is the command of step i-1.
 inline SensorRecord RecordOf(const rundir::RecordedStep& step, const app::RunConfig& config,
                              std::size_t i, double previous_t, const Twist2& applied) {
   SensorRecord record;

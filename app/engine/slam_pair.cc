@@ -1,0 +1,158 @@
+#include "app/engine/slam_pair.h"
+
+#include <chrono>
+#include <cmath>
+#include <string>
+
+#include "common/check.h"
+#include "eval/pose_metrics.h"
+#include "rundir/layout.h"
+#include "rundir/map_csv.h"
+#include "slam/feature_extraction.h"
+
+namespace mjslam::app {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double MicrosecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double, std::micro>(Clock::now() - start).count();
+}
+
+}  // namespace
+
+FilterTiming FilterTimingFromText(const std::string& text) {
+  if (text == "realtime") return FilterTiming::kRealtime;
+  MJSLAM_CHECK(text == "every_scan");
+  return FilterTiming::kEveryScan;
+}
+
+SlamPair::SlamPair(const slam::SlamParams& params, const ControlParams& control, double dt_s,
+                   const Pose2& X_WR0, const Pose2& X_RS, const Rng& run_rng)
+    : params_(params),
+      control_(control),
+      dt_s_(dt_s),
+      timing_(FilterTimingFromText(params.timing)) {
+  const slam::InnovationCheck check(params.innovation_check,
+                                    slam::ChiSquare2Quantile(params.ekf.gate_probability));
+  filters_.emplace_back(
+      "classical",
+      slam::EkfSlam(params.ekf, slam::CorrectionMode::kClassical, X_WR0, X_RS,
+                    run_rng.Fork("slam.classical.selection")),
+      check);
+  // The selective filter's draws (slam.ekf.selection_policy: random) are a
+  // stream of their own, forked from the run seed by name.
+  filters_.emplace_back(
+      "selective",
+      slam::EkfSlam(params.ekf, slam::CorrectionMode::kSelective, X_WR0, X_RS,
+                    run_rng.Fork("slam.selective.selection")),
+      check);
+}
+
+void SlamPair::Step(const SensorRecord& record) {
+  const int step = step_++;
+  // Who processes this record: every filter, or in realtime timing those
+  // whose last period has run out.
+  bool any_processes = false;
+  for (Filter& f : filters_) {
+    f.processed = timing_ == FilterTiming::kEveryScan || step >= f.next_free_step;
+    any_processes = any_processes || f.processed;
+  }
+  slam::ScanFeatures features;
+  double extraction_us = 0.0;
+  if (record.has_scan && any_processes) {
+    const Clock::time_point start = Clock::now();
+    features = slam::ExtractFeatures(record.scan, params_.features);
+    extraction_us = MicrosecondsSince(start);
+  }
+  for (Filter& f : filters_) {
+    if (f.processed) {
+      const Clock::time_point start = Clock::now();
+      const slam::ScanFeatures* given = record.has_scan ? &features : nullptr;
+      f.report = timing_ == FilterTiming::kEveryScan ? f.filter.Step(record, given)
+                                                     : CatchUpAndStep(&f, step, record, given);
+      f.processing_us = extraction_us + MicrosecondsSince(start);
+      f.processing_s = ProcessingSeconds(control_, f.report, record.has_scan, f.processing_us);
+      f.period_steps = CommandPeriodSteps(f.processing_s, dt_s_);
+      f.total_processing_s += f.processing_s;
+      f.next_free_step = step + f.period_steps;
+      f.last_processed_t_s = record.t_s;
+      if (record.has_scan) ++f.scans_processed;
+      f.innovation_check.Add(record.t_s, f.report.nis_sum, f.report.num_matched,
+                             f.report.num_observed,
+                             f.innovation_check.NearMisses(f.report.nearest_nis),
+                             f.innovation_check.Copies(f.report.association, f.report.nearest_nis));
+    } else {
+      // Busy: the scan is lost; with command input the record's command
+      // waits for the next prediction.
+      if (!slam::PredictsFromOdometry(params_.ekf.process_model)) {
+        SensorRecord motion;
+        motion.t_s = record.t_s;
+        motion.dt_s = record.dt_s;
+        motion.command = record.command;
+        motion.X_OR = record.X_OR;
+        f.skipped_records.push_back(motion);
+      }
+      slam::StepReport held;
+      held.num_features = f.report.num_features;
+      f.report = held;
+      f.processing_us = 0.0;
+      f.processing_s = 0.0;
+      if (record.has_scan) ++f.scans_skipped;
+    }
+    // The filter's command timeline: a period starts at each processed
+    // record (in realtime timing exactly when the last one has run out).
+    if (f.steps_to_next_command <= 0) {
+      f.open_loop_s += (f.period_steps - 1) * dt_s_;
+      f.steps_to_next_command = f.period_steps;
+    }
+    --f.steps_to_next_command;
+  }
+}
+
+slam::StepReport SlamPair::CatchUpAndStep(Filter* f, int step, const SensorRecord& record,
+                                          const slam::ScanFeatures* features) {
+  // Command input: one prediction per skipped record, each with its own
+  // command and dt, as if the filter had run them.
+  for (const SensorRecord& skipped : f->skipped_records) f->filter.Step(skipped, nullptr);
+  f->skipped_records.clear();
+  // (The first record, step 0, has no earlier one: it predicts nothing.)
+  if (!slam::PredictsFromOdometry(params_.ekf.process_model) || step == 0) {
+    return f->filter.Step(record, features);
+  }
+  // Odometry input: the filter takes the increment from the odometry pose of
+  // its last processed record; dt is the whole time since that record.
+  SensorRecord since_last = record;
+  since_last.dt_s = record.t_s - f->last_processed_t_s;
+  return f->filter.Step(since_last, features);
+}
+
+std::vector<rundir::FilterRow> SlamPair::Rows(const Pose2& X_WR_true) {
+  std::vector<rundir::FilterRow> rows;
+  for (Filter& f : filters_) {
+    if (f.processed) f.X_WR_true_processed = X_WR_true;
+    rundir::FilterRow row;
+    row.X_WR = f.filter.X_WR();
+    row.P = f.filter.pose_covariance();
+    row.num_features = f.report.num_features;
+    row.num_matched = f.report.num_matched;
+    row.num_updated = f.report.num_updated;
+    row.processing_us = f.processing_us;
+    row.period_s = f.period_steps * dt_s_;
+    row.open_loop_s = f.open_loop_s;
+    row.processed = f.processed;
+    // Not finite where P is (nearly) singular: the known start and the steps after.
+    row.nees = eval::EvaluatePoseStep(f.X_WR_true_processed, row.X_WR, row.P).nees;
+    rows.push_back(row);
+  }
+  return rows;
+}
+
+void WriteMaps(const SlamPair& slam, const std::string& dir) {
+  for (int f = 0; f < 2; ++f) {
+    rundir::WriteMapCsv(rundir::PathIn(dir, rundir::MapFile(slam.name(f))),
+                        slam.filter(f).Map());
+  }
+}
+
+}  // namespace mjslam::app

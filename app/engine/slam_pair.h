@@ -1,0 +1,145 @@
+#pragma once
+
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "app/engine/control.h"
+#include "common/records.h"
+#include "common/rng.h"
+#include "eval/map_types.h"
+#include "rundir/rows.h"
+#include "slam/ekf_slam.h"
+#include "slam/innovation_check.h"
+#include "slam/slam_params.h"
+
+namespace mjslam::app {
+
+/// When each filter runs (`slam.timing`; docs/method.md, "Real-time filter
+/// timing").
+enum class FilterTiming {
+  /// Every filter processes every record, whatever its processing time.
+  kEveryScan,
+  /// A filter that processed a record at step s is busy until step s + its
+  /// command period: the records of the steps in between are not processed
+  /// (their scans are skipped); their motion enters the prediction of the
+  /// next record it processes.
+  kRealtime,
+};
+
+/// The FilterTiming of the `slam.timing` text ("every_scan", "realtime");
+/// SlamParams::Validate() has checked it. Aborts on any other text.
+FilterTiming FilterTimingFromText(const std::string& text);
+
+/// The two filters of the paper on the same records: the classical sequential
+/// EKF and the selective one. Features are extracted once per scan and given
+/// to both; each filter's processing time is that extraction plus its own
+/// step, measured with a steady clock. Each filter's processing time also
+/// gives the command period it would impose (ControlParams). With
+/// `slam.timing: realtime` each filter runs on its own timeline
+/// (FilterTiming::kRealtime).
+class SlamPair {
+ public:
+  /// X_WR0: known initial pose of R; X_RS: the laser mount on R; `dt_s` the
+  /// control period without delay (one control step); `run_rng` the run
+  /// seed's stream, from which each filter forks its own draws by name (the
+  /// random selection policy).
+  SlamPair(const slam::SlamParams& params, const ControlParams& control, double dt_s,
+           const Pose2& X_WR0, const Pose2& X_RS, const Rng& run_rng);
+
+  /// Runs both filters on one record, the record of the next control step
+  /// (the first call is step 0). In realtime timing, a filter still busy
+  /// with an earlier record skips this one (processed(i) is false after the
+  /// call): its estimate and map stay those of its last processed record.
+  /// A filter that is free predicts over every step since its last processed
+  /// record, then processes this one: with a process model of kind command,
+  /// one prediction per skipped record with that record's own command and dt;
+  /// of kind odometry, one prediction from the odometry pose of its
+  /// last processed record to this one's, dt the time between them.
+  void Step(const SensorRecord& record);
+
+  /// Both filters' columns of trajectory.csv after the last step, in the
+  /// order of rundir::FilterNames(); X_WR_true is this step's true pose of R.
+  /// A filter that skipped the step reports its last processed estimate,
+  /// covariance and map size, 0 matched, updated and microseconds, the period
+  /// still running, and processed = false; its NEES compares that estimate
+  /// with the true pose of the step it refers to (its last processed one),
+  /// not with this step's.
+  std::vector<rundir::FilterRow> Rows(const Pose2& X_WR_true);
+
+  /// Processing time of filter `i` (0 classical, 1 selective) for the last
+  /// step, seconds (ControlParams::processing), and the command period it
+  /// imposes, in control steps.
+  double processing_s(int i) const { return filters_[i].processing_s; }
+  int period_steps(int i) const { return filters_[i].period_steps; }
+  /// Totals so far of filter `i`: processing time, and open-loop time on its
+  /// own command timeline (a command is issued when the last one's period
+  /// has run out and held for the period of that step; all of it but one
+  /// control step runs open loop), seconds.
+  double total_processing_s(int i) const { return filters_[i].total_processing_s; }
+  double open_loop_s(int i) const { return filters_[i].open_loop_s; }
+  /// Whether filter `i` processed the last step's record (always in
+  /// every_scan timing), and its counts so far of scans processed and of
+  /// scans skipped because it was busy.
+  bool processed(int i) const { return filters_[i].processed; }
+  int scans_processed(int i) const { return filters_[i].scans_processed; }
+  int scans_skipped(int i) const { return filters_[i].scans_skipped; }
+  /// What the check of filter `i` against its own innovations found so far
+  /// (slam.innovation_check; slam::InnovationCheck).
+  slam::InnovationCheckResult innovation_check(int i) const {
+    return filters_[i].innovation_check.result();
+  }
+  /// The timing the pair runs with.
+  FilterTiming timing() const { return timing_; }
+  /// Filter `i` by index, and its name.
+  const slam::EkfSlam& filter(int i) const { return filters_[i].filter; }
+  const std::string& name(int i) const { return filters_[i].name; }
+
+  const slam::EkfSlam& classical() const { return filters_[0].filter; }
+  const slam::EkfSlam& selective() const { return filters_[1].filter; }
+
+ private:
+  struct Filter {
+    Filter(std::string name_in, slam::EkfSlam filter_in, slam::InnovationCheck check_in)
+        : name(std::move(name_in)), filter(std::move(filter_in)), innovation_check(check_in) {}
+    std::string name;
+    slam::EkfSlam filter;
+    slam::InnovationCheck innovation_check;
+    slam::StepReport report;
+    double processing_us = 0.0;
+    double processing_s = 0.0;
+    int period_steps = 1;
+    double total_processing_s = 0.0;
+    double open_loop_s = 0.0;
+    int steps_to_next_command = 0;
+    // Realtime timing: the first step at which the filter is free again,
+    // the time of its last processed record, and (command input) the
+    // records of the steps it skipped since, without their scans.
+    int next_free_step = 0;
+    double last_processed_t_s = 0.0;
+    std::vector<SensorRecord> skipped_records;
+    bool processed = true;
+    // The true pose at the last processed step: what the estimate is of.
+    Pose2 X_WR_true_processed;
+    int scans_processed = 0;
+    int scans_skipped = 0;
+  };
+  // Realtime timing: filter `f` catches up over the records it skipped and
+  // processes `record`, the record of control step `step` (the features
+  // when it has a scan). Returns the filter's step report.
+  slam::StepReport CatchUpAndStep(Filter* f, int step, const SensorRecord& record,
+                                  const slam::ScanFeatures* features);
+
+  slam::SlamParams params_;
+  ControlParams control_;
+  double dt_s_;
+  FilterTiming timing_;
+  int step_ = 0;  // index of the next record
+  std::vector<Filter> filters_;
+};
+
+/// Writes each filter's map (map_classical.csv, map_selective.csv) into the
+/// run directory `dir`.
+void WriteMaps(const SlamPair& slam, const std::string& dir);
+
+}  // namespace mjslam::app

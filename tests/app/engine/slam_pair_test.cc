@@ -1,0 +1,249 @@
+// SlamPair's realtime timing on synthetic records: a filter busy for k
+// control steps skips exactly the scans of those steps, and its prediction
+// over the skipped steps integrates all of their motion.
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "app/engine/control.h"
+#include "app/engine/slam_pair.h"
+#include "common/records.h"
+#include "eval/pose_metrics.h"
+#include "slam/slam_params.h"
+
+namespace mjslam::app {
+namespace {
+
+constexpr double kDt = 0.1;  // control step, seconds
+
+// A scan with no return on any beam: no features, so the cost model charges
+// only model_base_s for it.
+LaserScan EmptyScan(double t_s) {
+  LaserScan scan;
+  scan.t_s = t_s;
+  scan.angle_min_rad = -M_PI / 2;
+  scan.angle_increment_rad = M_PI / 180.0;
+  scan.max_range_m = 8.0;
+  scan.ranges_m.assign(181, scan.max_range_m);
+  scan.has_return.assign(181, 0);
+  return scan;
+}
+
+// Records of a robot driving straight along x from the origin: step k has
+// the command `v_mps[k]` applied over the step before it, the odometry pose
+// integrated from those commands, and a scan.
+std::vector<SensorRecord> StraightRecords(const std::vector<double>& v_mps) {
+  std::vector<SensorRecord> records;
+  double x = 0.0;
+  for (std::size_t k = 0; k < v_mps.size(); ++k) {
+    SensorRecord record;
+    record.t_s = k * kDt;
+    record.dt_s = k == 0 ? 0.0 : record.t_s - records.back().t_s;
+    record.command.v_mps = k == 0 ? 0.0 : v_mps[k];
+    x += record.command.v_mps * record.dt_s;
+    record.X_OR = Pose2(x, 0.0, 0.0);
+    record.has_scan = true;
+    record.scan = EmptyScan(record.t_s);
+    records.push_back(record);
+  }
+  return records;
+}
+
+// The cost model only: each scan costs `base_s`.
+ControlParams ModelCost(double base_s) {
+  ControlParams control;
+  control.processing = "model";
+  control.model_base_s = base_s;
+  control.model_s_per_update_per_n2 = 0.0;
+  return control;
+}
+
+slam::SlamParams Timing(const std::string& timing, const std::string& input) {
+  slam::SlamParams params;
+  params.timing = timing;
+  if (input == "odometry") params.ekf.process_model = slam::OdometryProcessModel{};
+  return params;
+}
+
+TEST(SlamPairTest, TimingTextBecomesTheEnum) {
+  EXPECT_EQ(FilterTimingFromText("every_scan"), FilterTiming::kEveryScan);
+  EXPECT_EQ(FilterTimingFromText("realtime"), FilterTiming::kRealtime);
+  slam::SlamParams params;
+  EXPECT_EQ(params.timing, "every_scan");
+  EXPECT_TRUE(params.Validate().empty());
+  params.timing = "sometimes";
+  ASSERT_EQ(params.Validate().size(), 1u);
+  EXPECT_EQ(params.Validate()[0].key, "timing");
+}
+
+// A period of k steps (cost 0.1 (k - 1) + 0.05 s): the filter processes
+// steps 0, k, 2k, ... and skips the scans of every step in between.
+TEST(SlamPairTest, RealtimeFilterBusyForKStepsSkipsExactlyThoseScans) {
+  const std::vector<SensorRecord> records = StraightRecords(std::vector<double>(20, 0.3));
+  for (const int k : {1, 2, 3, 5}) {
+    SlamPair pair(Timing("realtime", "command"), ModelCost(kDt * (k - 1) + 0.05), kDt,
+                  Pose2(), Pose2(), Rng(1));
+    int processed = 0;
+    for (int s = 0; s < static_cast<int>(records.size()); ++s) {
+      pair.Step(records[s]);
+      for (int f = 0; f < 2; ++f) {
+        EXPECT_EQ(pair.processed(f), s % k == 0) << "k " << k << " step " << s << " filter " << f;
+        EXPECT_EQ(pair.period_steps(f), k) << "k " << k << " step " << s;
+      }
+      processed += s % k == 0 ? 1 : 0;
+    }
+    for (int f = 0; f < 2; ++f) {
+      EXPECT_EQ(pair.scans_processed(f), processed) << "k " << k;
+      EXPECT_EQ(pair.scans_skipped(f), 20 - processed) << "k " << k;
+    }
+  }
+}
+
+// The same records in every_scan timing: every scan processed, whatever the
+// period.
+TEST(SlamPairTest, EveryScanTimingProcessesEveryScan) {
+  const std::vector<SensorRecord> records = StraightRecords(std::vector<double>(10, 0.3));
+  SlamPair pair(Timing("every_scan", "command"), ModelCost(0.25), kDt, Pose2(), Pose2(), Rng(1));
+  for (const SensorRecord& record : records) {
+    pair.Step(record);
+    EXPECT_TRUE(pair.processed(0));
+    EXPECT_TRUE(pair.processed(1));
+    EXPECT_EQ(pair.period_steps(0), 3);
+  }
+  EXPECT_EQ(pair.scans_processed(0), 10);
+  EXPECT_EQ(pair.scans_skipped(0), 0);
+}
+
+// A skipped step's row holds the last processed estimate and says so.
+TEST(SlamPairTest, SkippedStepReportsTheLastProcessedEstimate) {
+  const std::vector<SensorRecord> records = StraightRecords(std::vector<double>(4, 0.5));
+  SlamPair pair(Timing("realtime", "command"), ModelCost(0.25), kDt, Pose2(), Pose2(), Rng(1));
+  pair.Step(records[0]);
+  const std::vector<rundir::FilterRow> first = pair.Rows(Pose2());
+  pair.Step(records[1]);
+  const std::vector<rundir::FilterRow> skipped = pair.Rows(Pose2(0.05, 0.0, 0.0));
+  for (int f = 0; f < 2; ++f) {
+    EXPECT_TRUE(first[f].processed);
+    EXPECT_FALSE(skipped[f].processed);
+    EXPECT_EQ(skipped[f].X_WR.x, first[f].X_WR.x);
+    EXPECT_EQ(skipped[f].P, first[f].P);
+    EXPECT_EQ(skipped[f].processing_us, 0.0);
+    EXPECT_DOUBLE_EQ(skipped[f].period_s, 0.30000000000000004);
+  }
+}
+
+// A skipped step's NEES compares the estimate it holds (of its last processed
+// step) with the truth of that step, not with the truth of the step skipped:
+// the row repeats the processed row's NEES, which the current truth would
+// change.
+TEST(SlamPairTest, SkippedStepNeesIsThatOfTheStepItsEstimateIsOf) {
+  const std::vector<SensorRecord> records = StraightRecords(std::vector<double>(12, 0.5));
+  SlamPair pair(Timing("realtime", "command"), ModelCost(0.25), kDt, Pose2(), Pose2(), Rng(1));
+  std::vector<double> processed_nees(2, std::nan(""));
+  int finite_skipped = 0;
+  for (std::size_t k = 0; k < records.size(); ++k) {
+    pair.Step(records[k]);
+    // A truth a little off the commanded path, so that the NEES changes.
+    const Pose2 truth(records[k].X_OR.x + 0.004 * k, 0.002 * k, 0.001 * k);
+    const std::vector<rundir::FilterRow> rows = pair.Rows(truth);
+    for (int f = 0; f < 2; ++f) {
+      if (rows[f].processed) {
+        processed_nees[f] = rows[f].nees;
+        continue;
+      }
+      if (!std::isfinite(processed_nees[f])) continue;
+      ++finite_skipped;
+      EXPECT_EQ(rows[f].nees, processed_nees[f]) << "step " << k << " filter " << f;
+      EXPECT_NE(rows[f].nees, eval::EvaluatePoseStep(truth, rows[f].X_WR, rows[f].P).nees);
+    }
+  }
+  EXPECT_GT(finite_skipped, 4);
+}
+
+// Driving straight with a different command on each step, a filter busy for
+// 3 steps is, at its next processed step, where the commands of all 3 steps
+// take it (not 3 times the last one), exactly as a filter that ran every
+// step; in between it holds its last estimate.
+TEST(SlamPairTest, RealtimePredictionIntegratesEveryCommandOfTheSkippedSteps) {
+  const std::vector<double> v = {0.0, 0.1, 0.2, 0.4, 0.3, 0.5, 0.1, 0.2, 0.3, 0.6, 0.2};
+  const std::vector<SensorRecord> records = StraightRecords(v);
+  SlamPair realtime(Timing("realtime", "command"), ModelCost(0.25), kDt, Pose2(), Pose2(), Rng(1));
+  SlamPair every_scan(Timing("every_scan", "command"), ModelCost(0.25), kDt, Pose2(), Pose2(), Rng(1));
+  double x = 0.0;
+  double x_processed = 0.0;
+  for (int s = 0; s < static_cast<int>(records.size()); ++s) {
+    realtime.Step(records[s]);
+    every_scan.Step(records[s]);
+    x += v[s] * kDt * (s > 0 ? 1 : 0);
+    for (int f = 0; f < 2; ++f) {
+      if (s % 3 == 0) {
+        ASSERT_TRUE(realtime.processed(f)) << "step " << s;
+        EXPECT_NEAR(realtime.filter(f).X_WR().x, x, 1e-12) << "step " << s;
+        EXPECT_EQ(realtime.filter(f).X_WR().x, every_scan.filter(f).X_WR().x) << "step " << s;
+        EXPECT_EQ(realtime.filter(f).pose_covariance(), every_scan.filter(f).pose_covariance())
+            << "step " << s;
+      } else {
+        ASSERT_FALSE(realtime.processed(f)) << "step " << s;
+        EXPECT_EQ(realtime.filter(f).X_WR().x, x_processed) << "step " << s;
+      }
+    }
+    if (s % 3 == 0) x_processed = realtime.filter(0).X_WR().x;
+  }
+  // The robot moved: a prediction that dropped the skipped steps would be off.
+  EXPECT_GT(x, 0.2);
+}
+
+// With odometry input the prediction of the next processed step takes the
+// odometry increment over all the skipped steps at once.
+TEST(SlamPairTest, RealtimePredictionTakesTheOdometryOfTheSkippedSteps) {
+  const std::vector<double> v(13, 0.5);
+  const std::vector<SensorRecord> records = StraightRecords(v);
+  SlamPair realtime(Timing("realtime", "odometry"), ModelCost(0.35), kDt, Pose2(), Pose2(), Rng(1));
+  for (int s = 0; s < static_cast<int>(records.size()); ++s) {
+    realtime.Step(records[s]);
+    const double expected = s % 4 == 0 ? s * kDt * 0.5 : (s / 4) * 4 * kDt * 0.5;
+    for (int f = 0; f < 2; ++f) {
+      EXPECT_EQ(realtime.processed(f), s % 4 == 0) << "step " << s;
+      EXPECT_NEAR(realtime.filter(f).X_WR().x, expected, 1e-12) << "step " << s;
+      EXPECT_NEAR(realtime.filter(f).X_WR().y, 0.0, 1e-12) << "step " << s;
+    }
+  }
+  EXPECT_EQ(realtime.scans_processed(0), 4);
+  EXPECT_EQ(realtime.scans_skipped(0), 9);
+}
+
+// On an arc the skid term of the prediction depends on dt: the odometry
+// prediction over skipped steps must use the whole time since the last
+// processed record, as one filter given just those two records would.
+TEST(SlamPairTest, RealtimeOdometryPredictionUsesTheWholeElapsedTime) {
+  std::vector<SensorRecord> records = StraightRecords(std::vector<double>(5, 0.5));
+  for (std::size_t k = 0; k < records.size(); ++k) {
+    const double th = 0.5 * k * kDt;  // 0.5 rad/s on a 1 m radius
+    records[k].X_OR = Pose2(std::sin(th), 1.0 - std::cos(th), th);
+  }
+  slam::SlamParams params = Timing("realtime", "odometry");
+  ASSERT_GT(slam::LateralOf(params.ekf.process_model).skid_s, 0.0);
+  SlamPair realtime(params, ModelCost(0.35), kDt, Pose2(), Pose2(), Rng(1));
+  for (const SensorRecord& record : records) realtime.Step(record);
+  ASSERT_TRUE(realtime.processed(0));
+
+  // The reference: the first record, then the last with dt = 0.4 s.
+  const slam::ScanFeatures none;
+  slam::EkfSlam reference(params.ekf, slam::CorrectionMode::kClassical, Pose2(), Pose2());
+  reference.Step(records[0], &none);
+  SensorRecord last = records[4];
+  last.dt_s = 4 * kDt;
+  reference.Step(last, &none);
+  EXPECT_NEAR(realtime.filter(0).X_WR().x, reference.X_WR().x, 1e-15);
+  EXPECT_NEAR(realtime.filter(0).X_WR().y, reference.X_WR().y, 1e-15);
+  // With the last step's dt alone the skid would be 4 times larger.
+  slam::EkfSlam short_dt(params.ekf, slam::CorrectionMode::kClassical, Pose2(), Pose2());
+  short_dt.Step(records[0], &none);
+  short_dt.Step(records[4], &none);
+  EXPECT_GT(std::abs(short_dt.X_WR().y - reference.X_WR().y), 1e-6);
+}
+
+}  // namespace
+}  // namespace mjslam::app
