@@ -396,6 +396,11 @@ int EvaluateMain(const EvaluateCommand& c) {
                 p.inside_2sigma(2), p.mean_nees, m.matched_fraction, m.num_duplicates,
                 m.num_unmatched_estimates, m.num_inconsistent);
   }
+  const ObservationCheck& o = result.observations;
+  std::printf("line observations against the true walls: %d of %d on a wall, mean NIS %.3f "
+              "(2 if the extractor's covariances hold), above 9.21: %.4f, largest %.1f, "
+              "range bias %.4f m removed\n",
+              o.matched, o.lines, o.mean_nis, o.fraction_above_gate, o.max_nis, o.range_bias_m);
   if (result.has_divergence) {
     std::printf("divergence: classical||selective %.4g, selective||classical %.4g, "
                 "classical||truth %.4g, selective||truth %.4g\n",
@@ -404,10 +409,10 @@ int EvaluateMain(const EvaluateCommand& c) {
   }
   if (c.profile) {
     const EvaluationCpu& cpu = result.cpu;
-    std::printf("cpu s: trajectory %.3f, ground truth %.3f, poses %.3f, maps %.3f, "
-                "divergence %.3f, summary %.3f, total %.3f\n",
-                cpu.trajectory_s, cpu.ground_truth_s, cpu.poses_s, cpu.maps_s, cpu.divergence_s,
-                cpu.summary_s, cpu.total_s);
+    std::printf("cpu s: trajectory %.3f, ground truth %.3f, observations %.3f, poses %.3f, "
+                "maps %.3f, divergence %.3f, summary %.3f, total %.3f\n",
+                cpu.trajectory_s, cpu.ground_truth_s, cpu.observations_s, cpu.poses_s, cpu.maps_s,
+                cpu.divergence_s, cpu.summary_s, cpu.total_s);
   }
   return 0;
 }

@@ -142,6 +142,10 @@ RunEvaluation EvaluateRunDirectory(const std::string& run_dir, const EvaluateOpt
   result.truth = RunGroundTruth(run_dir, options.ground_truth);
   rundir::WriteMapCsv(rundir::PathIn(run_dir, rundir::kGroundTruthMapFile), result.truth);
   laps.Charge(&result.cpu.ground_truth_s);
+  result.observations = CheckLineObservations(
+      rundir::PathIn(run_dir, rundir::kScansFile),
+      LoadRunConfig(rundir::PathIn(run_dir, rundir::kConfigFile), {}), result.truth);
+  laps.Charge(&result.cpu.observations_s);
 
   // Poses and maps of both filters.
   std::vector<eval::Map> maps;
@@ -190,6 +194,13 @@ RunEvaluation EvaluateRunDirectory(const std::string& run_dir, const EvaluateOpt
                 {"line_alpha_rmse_rad", Number(map.line_alpha_rmse_rad)},
                 {"corner_rmse_m", Number(map.corner_rmse_m)}};
   }
+  const ObservationCheck& o = result.observations;
+  summary["observations"] = {{"lines", o.lines},
+                             {"matched", o.matched},
+                             {"range_bias_m", o.range_bias_m},
+                             {"mean_nis", Number(o.mean_nis)},
+                             {"fraction_above_gate", Number(o.fraction_above_gate)},
+                             {"max_nis", Number(o.max_nis)}};
   if (result.has_divergence) {
     summary["divergence"] = {{"num_points", options.divergence_points},
                              {"realisations", options.divergence_realisations},

@@ -11,6 +11,7 @@
 #include "eval/map_matching.h"
 #include "eval/map_types.h"
 #include "eval/pose_metrics.h"
+#include "app/jobs/observation_check.h"
 #include "sim/sim_params.h"
 
 namespace mjslam::app {
@@ -37,6 +38,8 @@ struct EvaluationCpu {
   double poses_s = 0.0;
   /// Reading both map files and matching them with the truth.
   double maps_s = 0.0;
+  /// Re-extracting the scans' lines against the truth (CheckLineObservations).
+  double observations_s = 0.0;
   /// The map divergence (eval::DivergenceStudy).
   double divergence_s = 0.0;
   /// Merging into summary.json.
@@ -51,6 +54,8 @@ struct RunEvaluation {
   eval::Map truth;
   std::vector<eval::PoseSummary> pose;
   std::vector<eval::MapMatchReport> map;
+  /// The scans' line observations against the true walls.
+  ObservationCheck observations;
   /// Set when divergence_points > 0.
   bool has_divergence = false;
   eval::MapDivergences divergence;
@@ -94,7 +99,8 @@ std::vector<double> PoseNees(const rundir::CsvTable& trajectory, const std::stri
 /// seed). Merges the results into summary.json (created if missing; other
 /// writers' keys are kept): for each filter `filters.<f>.inside_2sigma`,
 /// `rmse` ({x, y, th}), `mean_nees`, `final_pose_error` ({x, y, th}),
-/// `num_features`, `map` {...}, and `divergence` {...} (docs/commands.md, "mjslam
+/// `num_features`, `map` {...}, `observations` {...} (CheckLineObservations
+/// over scans.csv) and `divergence` {...} (docs/commands.md, "mjslam
 /// evaluate"). Files are written atomically. Throws std::runtime_error naming
 /// the file for a missing or malformed input.
 RunEvaluation EvaluateRunDirectory(const std::string& run_dir, const EvaluateOptions& options = {});
