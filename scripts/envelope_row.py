@@ -3,7 +3,8 @@
 
 Usage: envelope_row.py SWEEP_DIR NAME. Reads, with python/mjslam, SWEEP_DIR/summary.json
 and each run's summary.json (runs/run_*/summary.json) for the worst run's 2-sigma
-fraction (the smallest of its x, y, th). Debian's Python 3 with numpy (/usr/bin/python3).
+fraction (the smallest of its x, y, th) and the line observations against the true walls
+(their NIS pooled over the runs, weighted by the lines matched, and the largest). Debian's Python 3 with numpy (/usr/bin/python3).
 """
 import os
 import sys
@@ -37,6 +38,18 @@ def main():
         cells.append("%.3f / %.3f / %.3f" % (pooled.get("x", 0), pooled.get("y", 0),
                                              pooled.get("th", 0)))
         cells.append("%.3f" % worst)
+    # The line observations against the true walls (mjslam evaluate's `observations`),
+    # pooled over the runs: the mean NIS (2 when the extractor's covariances hold) and the
+    # largest.
+    observed = [run.summary.get("observations") or {} for run in runs]
+    weights = [o.get("matched") or 0 for o in observed]
+    nis = [(o.get("mean_nis"), w) for o, w in zip(observed, weights) if o.get("mean_nis") is not None]
+    if nis and sum(w for _, w in nis) > 0:
+        mean = sum(m * w for m, w in nis) / sum(w for _, w in nis)
+        largest = max(o.get("max_nis") or 0.0 for o in observed)
+        cells.append("%.2f, %.0f" % (mean, largest))
+    else:
+        cells.append("-")
     print("| " + " | ".join(cells) + " |")
 
 

@@ -36,8 +36,8 @@ conditions=(
   "generated building 702 (26 x 16 m, -8 deg, 0.9 m doors)|run.world=$out/worlds/test_building_702.xml run.duration_s=600"
   "range scale +0.1 %|laser.range_scale_fraction=0.001"
 )
-printf '| condition | classical: ANEES inside / above, mean | 2-sigma x / y / th | worst run 2-sigma | selective: ANEES inside / above, mean | 2-sigma x / y / th | worst run 2-sigma |\n'
-printf '|---|---|---|---|---|---|---|\n'
+printf '| condition | classical: ANEES inside / above, mean | 2-sigma x / y / th | worst run 2-sigma | selective: ANEES inside / above, mean | 2-sigma x / y / th | worst run 2-sigma | line observations: NIS mean, largest |\n'
+printf '|---|---|---|---|---|---|---|---|\n'
 i=0
 for entry in "${conditions[@]}"; do
   name=${entry%%|*}
