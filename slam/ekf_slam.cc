@@ -211,6 +211,72 @@ void EkfSlam::GrowSegment(int k, const Observation& observation) {
                                    X_WS * observation.p_SB);
 }
 
+bool EkfSlam::SameWall(int a, int b) const {
+  if (state_.feature_type(a) != FeatureType::kLine || state_.feature_type(b) != FeatureType::kLine) {
+    return false;
+  }
+  const int side_a = info_[a].seen_side;
+  const int side_b = info_[b].seen_side;
+  const Eigen::Vector2d f_a = state_.feature(a);
+  const Eigen::Vector2d f_b = state_.feature(b);
+  // Seen from the same side: the normals towards the sensor, -side n, agree.
+  const double normals = std::cos(f_a.y() - f_b.y());
+  if (side_a * side_b * normals <= 0.0) return false;
+  // The overlap of the seen segments, along line a.
+  const LineSegment& seg_a = info_[a].segment;
+  const LineSegment seg_b = SegmentFromPoints(f_a, PointOnLine(f_b, info_[b].segment.s_min),
+                                              PointOnLine(f_b, info_[b].segment.s_max));
+  const double s_from = std::max(seg_a.s_min, seg_b.s_min);
+  const double s_to = std::min(seg_a.s_max, seg_b.s_max);
+  if (s_to - s_from < params_.duplicate_line_min_overlap_m) return false;
+  // Line b's distance from line a's points at both ends of the overlap.
+  const Eigen::Vector2d n_b(std::cos(f_b.y()), std::sin(f_b.y()));
+  for (const double s : {s_from, s_to}) {
+    if (std::abs(n_b.dot(PointOnLine(f_a, s)) - f_b.x()) > params_.duplicate_line_distance_m) {
+      return false;
+    }
+  }
+  return true;
+}
+
+int EkfSlam::RemoveDuplicateLines(std::vector<int> touched) {
+  int removed = 0;
+  for (std::size_t t = 0; t < touched.size(); ++t) {
+    const int a = touched[t];
+    if (a < 0) continue;  // removed as a duplicate already
+    for (int b = 0; b < state_.num_features(); ++b) {
+      if (b == a || !SameWall(a, b)) continue;
+      const auto det = [&](int k) {
+        const Eigen::Matrix2d P = state_.feature_covariance(k);
+        return P(0, 0) * P(1, 1) - P(0, 1) * P(1, 0);
+      };
+      const bool keep_a = det(a) <= det(b);
+      const int keep = keep_a ? a : b;
+      const int drop = keep_a ? b : a;
+      const Eigen::Vector2d f_drop = state_.feature(drop);
+      info_[keep].segment =
+          ExtendSegment(info_[keep].segment, state_.feature(keep),
+                        PointOnLine(f_drop, info_[drop].segment.s_min),
+                        PointOnLine(f_drop, info_[drop].segment.s_max));
+      state_.RemoveFeature(drop);
+      info_.erase(info_.begin() + drop);
+      ++removed;
+      // The indices after `drop` moved down by one.
+      for (int& k : touched) {
+        if (k == drop) {
+          k = -1;
+        } else if (k > drop) {
+          --k;
+        }
+      }
+      if (drop == a) break;
+      // Line a stays; look again at the line now at index b.
+      --b;
+    }
+  }
+  return removed;
+}
+
 MotionInput EkfSlam::CheckedMotionInput(const SensorRecord& record) const {
   if (!std::isfinite(record.dt_s) || record.dt_s < 0.0) {
     throw SlamInputError("EkfSlam::Step: record.dt_s: expected a finite value >= 0 (got " +
@@ -389,7 +455,18 @@ StepReport EkfSlam::Step(const SensorRecord& record, const ScanFeatures* feature
   }
 
   // New features from the corrected pose (inverse observation models).
+  const int num_before_new = state_.num_features();
   AddNewFeatures(association, observations, *features, &report);
+
+  // A wall now mapped twice keeps its more certain line.
+  if (params_.duplicate_line_distance_m > 0.0) {
+    std::vector<int> touched;
+    for (const MatchedObservation& match : matched) {
+      if (state_.feature_type(match.feature) == FeatureType::kLine) touched.push_back(match.feature);
+    }
+    for (int k = num_before_new; k < state_.num_features(); ++k) touched.push_back(k);
+    RemoveDuplicateLines(std::move(touched));
+  }
   report.num_features = state_.num_features();
   return report;
 }

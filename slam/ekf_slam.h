@@ -61,7 +61,8 @@ struct StepReport {
   double nis_sum = 0.0;
   /// What became of each observation (lines first, then corners, as the
   /// features were extracted), for diagnostics: its outcome and matched
-  /// feature, and `nearest_nis`, the smallest NIS to any map feature of its
+  /// feature (an index into the map before this step's duplicate lines were
+  /// removed), and `nearest_nis`, the smallest NIS to any map feature of its
   /// type before the correction (+inf: none).
   Association association;
   std::vector<double> nearest_nis;
@@ -160,6 +161,14 @@ class EkfSlam {
   // Extends line k's seen segment with an observation's endpoints, seen from
   // the current pose estimate.
   void GrowSegment(int k, const Observation& observation);
+  // Whether map lines a and b are one wall seen twice
+  // (EkfParams::duplicate_line_distance_m), at the current estimate.
+  bool SameWall(int a, int b) const;
+  // For each line in `touched` (feature indices, those whose segments grew
+  // or that are new this step), removes the less certain line of every pair
+  // SameWall with it; the kept line's segment covers both. Returns how many
+  // lines were removed.
+  int RemoveDuplicateLines(std::vector<int> touched);
 
   // The steps of Step(), in order.
   // The motion input of `record` (odometry increment or command, with the

@@ -96,6 +96,8 @@ std::vector<ParamProblem> EkfParams::Validate() const {
   check.NonNegative("extra_corner_range_std_m", extra_corner_range_std_m);
   check.NonNegative("extra_corner_bearing_std_rad", extra_corner_bearing_std_rad);
   check.NonNegative("line_match_max_gap_m", line_match_max_gap_m);
+  check.NonNegative("duplicate_line_distance_m", duplicate_line_distance_m);
+  check.Positive("duplicate_line_min_overlap_m", duplicate_line_min_overlap_m);
   check.Require(gate_probability > 0.0 && gate_probability < 1.0, "gate_probability",
                 gate_probability, "a probability in (0, 1)");
   check.Require(new_feature_probability >= gate_probability && new_feature_probability < 1.0,

@@ -409,6 +409,17 @@ struct EkfParams {
   /// Real buildings have many collinear walls (both sides of a corridor's
   /// doors, offices in a row), which the infinite line model confuses.
   double line_match_max_gap_m = 0.0;
+  /// Duplicate map lines, metres: two map lines whose seen segments overlap
+  /// by at least `duplicate_line_min_overlap_m`, seen from the same side,
+  /// with each line within this distance of the other at both ends of the
+  /// overlap, are one wall seen twice (a wall seen in pieces farther apart
+  /// than the segment gate whose pieces grew together; a wall in front of
+  /// another would hide it). The less certain of the two (larger determinant
+  /// of its 2x2 covariance) is removed from the state, its marginal dropped
+  /// (docs/method.md, "Duplicate lines"). 0 (default): never, as in the paper.
+  double duplicate_line_distance_m = 0.0;
+  /// See `duplicate_line_distance_m`, metres (> 0).
+  double duplicate_line_min_overlap_m = 0.25;
   /// MAX of the paper's Algorithm 2: the most features used per correction by
   /// the selective filter (>= 1). Ignored by the classical filter.
   int max_updates = 2;
@@ -450,6 +461,8 @@ struct EkfParams {
     a->Visit(MJSLAM_NVP(correct_corners_of_matched_lines));
     a->Visit(MJSLAM_NVP(corners_from_map_lines));
     a->Visit(MJSLAM_NVP(line_match_max_gap_m));
+    a->Visit(MJSLAM_NVP(duplicate_line_distance_m));
+    a->Visit(MJSLAM_NVP(duplicate_line_min_overlap_m));
     a->Visit(MJSLAM_NVP(max_updates));
     a->Visit(MJSLAM_NVP(selection_policy));
   }

@@ -348,6 +348,27 @@ int SlamState::AddLineIntersection(int a, int b) {
   return Append(FeatureType::kCorner, f);
 }
 
+void SlamState::RemoveFeature(int k) {
+  MJSLAM_CHECK(k >= 0 && k < num_features());
+  const int j = FeatureIndex(k);
+  const int tail = n_ - j - 2;
+  if (tail > 0) {
+    P_.block(j, 0, tail, n_) = P_.block(j + 2, 0, tail, n_).eval();
+    P_.block(0, j, n_ - 2, tail) = P_.block(0, j + 2, n_ - 2, tail).eval();
+    x_.segment(j, tail) = x_.segment(j + 2, tail).eval();
+    if (jacobians_ == JacobianPoint::kFirstEstimates) {
+      x_first_.segment(j, tail) = x_first_.segment(j + 2, tail).eval();
+    }
+  }
+  // The freed rows and columns are left zero, as Reserve leaves new ones.
+  P_.block(n_ - 2, 0, 2, n_).setZero();
+  P_.block(0, n_ - 2, n_, 2).setZero();
+  x_.conservativeResize(n_ - 2);
+  if (jacobians_ == JacobianPoint::kFirstEstimates) x_first_.conservativeResize(n_ - 2);
+  types_.erase(types_.begin() + k);
+  n_ -= 2;
+}
+
 int SlamState::Append(FeatureType type, const Eigen::Vector2d& f) {
   x_.conservativeResize(n_ + 2);
   x_.segment<2>(n_) = f;

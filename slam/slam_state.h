@@ -168,6 +168,11 @@ class SlamState {
   /// Precondition (checked): a != b are lines that are not parallel.
   int AddLineIntersection(int a, int b);
 
+  /// Removes feature k from the state: its mean and its rows and columns of
+  /// P. The rest is the exact Gaussian marginal of the other entries, so no
+  /// information about them is lost or invented; features after k move down
+  /// one index. O(n^2) (the rows and columns after k move).
+  void RemoveFeature(int k);
   /// One sequential EKF correction (Algorithm 1, sentences iv-vi) with
   /// observation z of feature k, covariance R (SPD):
   ///   nu = z - h(xi) (angle wrapped; a line's h in z's polar form),

@@ -66,6 +66,8 @@ TEST(EkfParamsTest, DefaultsAreValidAndBadValuesAreNamed) {
   params.gate_probability = 1.0;
   params.new_feature_probability = 0.5;
   params.max_updates = 0;
+  params.duplicate_line_distance_m = -0.05;
+  params.duplicate_line_min_overlap_m = 0.0;
   const std::vector<ParamProblem> problems = params.Validate();
   std::string keys;
   for (const ParamProblem& problem : problems) keys += problem.key + " ";
@@ -74,6 +76,8 @@ TEST(EkfParamsTest, DefaultsAreValidAndBadValuesAreNamed) {
   EXPECT_NE(keys.find("gate_probability"), std::string::npos) << keys;
   EXPECT_NE(keys.find("new_feature_probability"), std::string::npos) << keys;
   EXPECT_NE(keys.find("max_updates"), std::string::npos) << keys;
+  EXPECT_NE(keys.find("duplicate_line_distance_m"), std::string::npos) << keys;
+  EXPECT_NE(keys.find("duplicate_line_min_overlap_m"), std::string::npos) << keys;
   EXPECT_NE(keys.find("process_model.noise.v_fraction"), std::string::npos) << keys;
   EXPECT_NE(keys.find("process_model.lateral.slip_std_m_per_rad"), std::string::npos) << keys;
   EXPECT_THROW(params.ValidateOrThrow(), ParamError);
@@ -518,6 +522,52 @@ TEST(EkfSlamTest, SecondaryMapExtendsAndFollowsTheLine) {
   filter.Step(Still(), &third);
   EXPECT_NEAR(filter.Map()[0].p_WA.y(), -1.0, 0.02);
   EXPECT_NEAR(filter.Map()[0].p_WB.y(), 3.0, 0.02);
+}
+
+// A wall seen in two pieces farther apart than the segment gate becomes two
+// map lines; once a scan shows it whole, their segments overlap and, with
+// duplicate_line_distance_m, the less certain line is removed and the kept
+// one's segment covers both. A parallel wall 0.1 m behind the first (a step
+// in the wall), seen over the same stretch, is another line and stays.
+TEST(EkfSlamTest, AWallMappedTwiceKeepsItsMoreCertainLine) {
+  for (const double distance : {0.0, 0.05}) {
+    EkfParams params;
+    params.line_match_max_gap_m = 0.5;
+    params.duplicate_line_distance_m = distance;
+    EkfSlam filter(params, CorrectionMode::kClassical, Pose2(), Pose2());
+    ScanFeatures first;
+    first.lines.push_back(WallAtTwo(0.0, -1.0, 1.0));
+    filter.Step(Still(), &first);
+    ScanFeatures pieces;
+    pieces.lines.push_back(WallAtTwo(0.0, -1.0, 1.0));
+    pieces.lines.push_back(WallAtTwo(0.0, 2.0, 3.0));  // 1 m beyond the first piece
+    const StepReport second = filter.Step(Still(), &pieces);
+    EXPECT_EQ(second.num_matched, 1);
+    EXPECT_EQ(second.num_new, 1);
+    ASSERT_EQ(filter.num_features(), 2);
+    const std::vector<MapFeature> before = filter.Map();
+
+    ScanFeatures whole;
+    whole.lines.push_back(WallAtTwo(0.0, -1.0, 3.0));
+    filter.Step(Still(), &whole);
+    if (distance == 0.0) {
+      EXPECT_EQ(filter.num_features(), 2);
+      continue;
+    }
+    ASSERT_EQ(filter.num_features(), 1);
+    // The first line, seen twice, is the more certain one.
+    const MapFeature wall = filter.Map()[0];
+    EXPECT_EQ(wall.id, before[0].id);
+    EXPECT_NEAR(std::min(wall.p_WA.y(), wall.p_WB.y()), -1.0, 0.02);
+    EXPECT_NEAR(std::max(wall.p_WA.y(), wall.p_WB.y()), 3.0, 0.02);
+    EXPECT_EQ(filter.covariance().rows(), 3 + 2);
+
+    ScanFeatures step;
+    step.lines.push_back(WallAtTwo(0.0, -1.0, 3.0));
+    step.lines.push_back(Line(2.1, 0.0, {2.1, -1.0}, {2.1, 3.0}));
+    filter.Step(Still(), &step);
+    EXPECT_EQ(filter.num_features(), 2);
+  }
 }
 
 TEST(EkfSlamTest, MapIsCanonicalWithStableIds) {

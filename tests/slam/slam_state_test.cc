@@ -303,6 +303,56 @@ TEST(SlamStateTest, CovarianceStaysExactlySymmetricAndPsdOverLongRandomRuns) {
   }
 }
 
+// Removing a feature leaves exactly the marginal of the rest: the mean and P
+// with that feature's entries deleted, bit for bit; a feature added after it
+// is augmented as if the removed one had never been there.
+TEST(SlamStateTest, RemovingAFeatureLeavesTheMarginalOfTheRest) {
+  for (const JacobianPoint jacobians : {JacobianPoint::kCurrent, JacobianPoint::kFirstEstimates}) {
+    Rng rng(31);
+    SlamState state = MakeState(&rng, 7);
+    if (jacobians == JacobianPoint::kFirstEstimates) {
+      SlamState fej(state.pose(), state.pose_covariance(), kMount, jacobians);
+      for (int k = 0; k < 7; ++k) {
+        fej.AddFeature(state.feature_type(k), state.Measure(k).h, RandomCovariance2(&rng, 0.02, 0.02));
+      }
+      state = fej;
+    }
+    for (const int k : {6, 2, 0}) {  // the last, a middle and the first feature
+      const Eigen::VectorXd x = state.mean();
+      const Eigen::VectorXd x_lin = state.linearization_point();
+      const Eigen::MatrixXd P = state.covariance();
+      const int n = state.dimension();
+      const int j = state.FeatureIndex(k);
+      std::vector<int> keep;
+      for (int i = 0; i < n; ++i) {
+        if (i != j && i != j + 1) keep.push_back(i);
+      }
+      const FeatureType after = k + 1 < state.num_features() ? state.feature_type(k + 1)
+                                                              : FeatureType::kLine;
+      state.RemoveFeature(k);
+      ASSERT_EQ(state.dimension(), n - 2);
+      for (int r = 0; r < n - 2; ++r) {
+        EXPECT_EQ(state.mean()[r], x[keep[r]]) << r;
+        EXPECT_EQ(state.linearization_point()[r], x_lin[keep[r]]) << r;
+        for (int c = 0; c < n - 2; ++c) {
+          EXPECT_EQ(state.covariance()(r, c), P(keep[r], keep[c])) << r << " " << c;
+        }
+      }
+      if (k + 1 < n / 2) EXPECT_EQ(state.feature_type(k), after);
+    }
+    // An augmentation after the removals: the new rows are G_pose P_pose,x,
+    // and nothing stale from the freed entries shows.
+    const Eigen::MatrixXd P = state.covariance();
+    const int k = state.AddFeature(FeatureType::kCorner, Eigen::Vector2d(2.0, 0.3),
+                                   Eigen::Matrix2d::Identity() * 1e-4);
+    const Eigen::MatrixXd P_new = state.covariance();
+    EXPECT_TRUE(P_new.topLeftCorner(P.rows(), P.cols()).isApprox(P, 0.0));
+    const Eigen::MatrixXd cross = P_new.block(state.FeatureIndex(k), 0, 2, P.cols());
+    const Eigen::MatrixXd G_pose = cross.leftCols<3>() * P.topLeftCorner<3, 3>().inverse();
+    EXPECT_TRUE(cross.isApprox(G_pose * P.topRows<3>(), 1e-9));
+  }
+}
+
 TEST(SlamStateTest, BufferGrowsGeometricallyAndKeepsP) {
   Rng rng(26);
   SlamState state(Eigen::Vector3d::Zero(), Eigen::Matrix3d::Identity() * 1e-4, kMount);
