@@ -44,7 +44,7 @@ import re
 import sys
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
-from generate_worlds import World, fmt  # noqa: E402
+from world_xml import World  # noqa: E402
 
 # The Pioneer 3-DX: 0.38 m wide; its body spans 0.47 m to 0.02 m behind the
 # point h (worlds/README.md).
