@@ -222,6 +222,11 @@ bool EkfSlam::SameWall(int a, int b) const {
   // Seen from the same side: the normals towards the sensor, -side n, agree.
   const double normals = std::cos(f_a.y() - f_b.y());
   if (side_a * side_b * normals <= 0.0) return false;
+  // Both ends of an overlap of at least min_overlap within `distance` of
+  // line b bound the angle between the lines: |sin| <= 2 distance /
+  // min_overlap. A cheaper test, implied by the ones below.
+  const double max_sin = 2.0 * params_.duplicate_line_distance_m / params_.duplicate_line_min_overlap_m;
+  if (max_sin < 1.0 && 1.0 - normals * normals > max_sin * max_sin) return false;
   // The overlap of the seen segments, along line a.
   const LineSegment& seg_a = info_[a].segment;
   const LineSegment seg_b = SegmentFromPoints(f_a, PointOnLine(f_b, info_[b].segment.s_min),
