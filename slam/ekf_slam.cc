@@ -245,19 +245,19 @@ bool EkfSlam::SameWall(int a, int b) const {
 }
 
 int EkfSlam::RemoveDuplicateLines(std::vector<int> touched) {
+  const auto det = [&](int k) {
+    const Eigen::Matrix2d P = state_.feature_covariance(k);
+    return P(0, 0) * P(1, 1) - P(0, 1) * P(1, 0);
+  };
   int removed = 0;
   for (std::size_t t = 0; t < touched.size(); ++t) {
-    const int a = touched[t];
-    if (a < 0) continue;  // removed as a duplicate already
-    for (int b = 0; b < state_.num_features(); ++b) {
+    // touched[t] follows its line as removals move the indices; -1 once the
+    // line itself was removed.
+    for (int b = 0; touched[t] >= 0 && b < state_.num_features(); ++b) {
+      const int a = touched[t];
       if (b == a || !SameWall(a, b)) continue;
-      const auto det = [&](int k) {
-        const Eigen::Matrix2d P = state_.feature_covariance(k);
-        return P(0, 0) * P(1, 1) - P(0, 1) * P(1, 0);
-      };
-      const bool keep_a = det(a) <= det(b);
-      const int keep = keep_a ? a : b;
-      const int drop = keep_a ? b : a;
+      const int keep = det(a) <= det(b) ? a : b;
+      const int drop = keep == a ? b : a;
       const Eigen::Vector2d f_drop = state_.feature(drop);
       info_[keep].segment =
           ExtendSegment(info_[keep].segment, state_.feature(keep),
@@ -266,7 +266,6 @@ int EkfSlam::RemoveDuplicateLines(std::vector<int> touched) {
       state_.RemoveFeature(drop);
       info_.erase(info_.begin() + drop);
       ++removed;
-      // The indices after `drop` moved down by one.
       for (int& k : touched) {
         if (k == drop) {
           k = -1;
@@ -274,9 +273,8 @@ int EkfSlam::RemoveDuplicateLines(std::vector<int> touched) {
           --k;
         }
       }
-      if (drop == a) break;
-      // Line a stays; look again at the line now at index b.
-      --b;
+      // Line a stays: look again at the line now at index b.
+      if (drop == b) --b;
     }
   }
   return removed;
