@@ -23,6 +23,17 @@ struct NameValue {
 /// `a->Visit(MJSLAM_NVP(rate_hz));` inside a Params' `Serialize`.
 #define MJSLAM_NVP(field) ::mjslam::NameValue<decltype(field)>{#field, &(field)}
 
+/// Whether `Archive` writes a Params struct out (config's WriteArchive says
+/// so with `static constexpr bool kWrites = true`) rather than reading or
+/// listing its fields: a Serialize may leave out a field at its default
+/// when writing, so that an optional key absent from a file stays absent
+/// from the resolved config.
+template <typename Archive, typename = void>
+struct ArchiveWrites : std::false_type {};
+template <typename Archive>
+struct ArchiveWrites<Archive, std::void_t<decltype(Archive::kWrites)>>
+    : std::bool_constant<Archive::kWrites> {};
+
 /// A key that a Params struct no longer reads, and the key (relative to the
 /// same struct) that took its place. A Params lists its own in
 /// `static constexpr RetiredKey kRetiredKeys[]`; the config reader reports

@@ -349,6 +349,8 @@ bool ReadValue(const ConfigNode& node, const std::string& key, T* value,
 /// Visits the fields of a Params struct while building one map node.
 class WriteArchive {
  public:
+  /// ArchiveWrites (common/params.h): this archive writes.
+  static constexpr bool kWrites = true;
   /// `map` must be a kMap node; fields are appended in visiting order.
   explicit WriteArchive(ConfigNode* map) : map_(map) {}
 

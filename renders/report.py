@@ -13,6 +13,7 @@ output is written to a temporary name and renamed. Exits 1 with a message
 naming the file on bad input.
 """
 import html
+import itertools
 import math
 import os
 import signal
@@ -30,7 +31,22 @@ import matplotlib.ticker  # noqa: E402
 
 # The renders' colours (renders/scene_renderer.h, namespace colors).
 COLORS = {"truth": "#0d0d0d", "classical": "#ff8000", "selective": "#0066ff"}
-FILTERS = mjslam.FILTER_NAMES
+FILTERS = mjslam.FILTER_NAMES  # the default filters (the paper's scripts use them)
+# Any other filter's colour, in turn (app/jobs/scene_frame.cc, FilterLayers).
+OTHER_COLORS = ("#009999", "#8c4d1a", "#808c00", "#f266a6", "#808080")
+
+
+def filters_of(table, suffix):
+    """The filters of a trajectory (suffix "x") or nees table (suffix "anees"): the prefixes f of
+    its f_<suffix> columns, in order, other than true and odom."""
+    names = [c[:-len(suffix) - 1] for c in table.columns if c.endswith("_" + suffix)]
+    return [f for f in names if f not in ("true", "odom")]
+
+
+def colors_of(names):
+    """Each filter's colour: classical and selective their own, the others OTHER_COLORS in turn."""
+    others = itertools.cycle(OTHER_COLORS)
+    return {f: COLORS[f] if f in FILTERS else next(others) for f in names}
 DPI = 100
 
 
@@ -75,15 +91,17 @@ def plot_pose_errors(traj, path):
     fig, axes = plt.subplots(3, 1, figsize=(8, 8), sharex=True)
     components = (("x", "pxx", "x error (m)"), ("y", "pyy", "y error (m)"),
                   ("th", "pthth", "heading error (rad)"))
+    names = filters_of(traj, "x")
+    colors = colors_of(names)
     for ax, (c, var, label) in zip(axes, components):
-        for f in FILTERS:
+        for f in names:
             err = [e - g for e, g in zip(traj[f"{f}_{c}"], traj[f"true_{c}"])]
             if c == "th":
                 err = [wrap(e) for e in err]
             bound = [2.0 * math.sqrt(max(v, 0.0)) for v in traj[f"{f}_{var}"]]
-            ax.plot(t, err, color=COLORS[f], lw=1.2, label=f"{f} error")
-            ax.plot(t, bound, color=COLORS[f], lw=0.9, ls="--", label=f"{f} ±2σ")
-            ax.plot(t, [-b for b in bound], color=COLORS[f], lw=0.9, ls="--")
+            ax.plot(t, err, color=colors[f], lw=1.2, label=f"{f} error")
+            ax.plot(t, bound, color=colors[f], lw=0.9, ls="--", label=f"{f} ±2σ")
+            ax.plot(t, [-b for b in bound], color=colors[f], lw=0.9, ls="--")
         ax.axhline(0.0, color="0.6", lw=0.6)
         ax.set_ylabel(label)
         ax.grid(True, alpha=0.3)
@@ -98,12 +116,14 @@ def plot_processing(traj, path):
     """Accumulated processing time of both filters (Fig. 4c)."""
     t = traj["t"]
     fig, ax = plt.subplots(figsize=(8, 4))
-    for f in FILTERS:
+    names = filters_of(traj, "x")
+    colors = colors_of(names)
+    for f in names:
         total, acc = 0.0, []
         for us in traj[f"{f}_us"]:
             total += 0.0 if math.isnan(us) else us * 1e-6
             acc.append(total)
-        ax.plot(t, acc, color=COLORS[f], lw=1.5, label=f)
+        ax.plot(t, acc, color=colors[f], lw=1.5, label=f)
     ax.set_xlabel("time (s)")
     ax.set_ylabel("accumulated processing time (s)")
     ax.set_title("Accumulated processing time, measured on this machine\n(feature extraction + filter step)")
@@ -117,8 +137,10 @@ def plot_open_loop(traj, path):
     """Accumulated open-loop time, f_open_loop (Fig. 4d)."""
     t = traj["t"]
     fig, ax = plt.subplots(figsize=(8, 4))
-    for f in FILTERS:
-        ax.plot(t, traj[f"{f}_open_loop"], color=COLORS[f], lw=1.5, label=f)
+    names = filters_of(traj, "x")
+    colors = colors_of(names)
+    for f in names:
+        ax.plot(t, traj[f"{f}_open_loop"], color=colors[f], lw=1.5, label=f)
     ax.set_xlabel("time (s)")
     ax.set_ylabel("accumulated open-loop time (s)")
     ax.set_title("Accumulated open-loop time (command period beyond 0.1 s)")
@@ -147,8 +169,10 @@ def plot_nees(nees, path, where=""):
     paper)."""
     fig, ax = plt.subplots(figsize=(8, 4))
     t = nees["t"]
-    for f in FILTERS:
-        ax.plot(t, nees[f"{f}_anees"], color=COLORS[f], lw=1.2, label=f"{f} ANEES")
+    names = filters_of(nees, "anees")
+    colors = colors_of(names)
+    for f in names:
+        ax.plot(t, nees[f"{f}_anees"], color=colors[f], lw=1.2, label=f"{f} ANEES")
     ax.plot(t, nees["lower"], color="0.3", lw=1.0, ls="--", label="95 % bounds")
     ax.plot(t, nees["upper"], color="0.3", lw=1.0, ls="--")
     n_runs = [n for n in nees["n_runs"] if not math.isnan(n)]
@@ -284,7 +308,7 @@ def run_report(directory):
     traj = mjslam.read_run(directory).trajectory
     plots = [("plot_pose_error.png", "Pose error and ±2σ bounds (paper Fig. 3c-e)", plot_pose_errors),
              ("plot_processing_time.png", "Accumulated processing time (Fig. 4c)", plot_processing)]
-    if all(f"{f}_open_loop" in traj for f in FILTERS):
+    if all(f"{f}_open_loop" in traj for f in filters_of(traj, "x")):
         plots.append(("plot_open_loop_time.png", "Accumulated open-loop time (Fig. 4d)", plot_open_loop))
     if "explored" in traj:
         plots.append(("plot_explored.png", "Explored fraction", plot_explored))

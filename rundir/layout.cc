@@ -1,10 +1,24 @@
 #include "rundir/layout.h"
 
+#include <stdexcept>
+
 namespace mjslam::rundir {
 
-const std::vector<std::string>& FilterNames() {
+const std::vector<std::string>& DefaultFilterNames() {
   static const std::vector<std::string> kNames = {"classical", "selective"};
   return kNames;
+}
+
+void RequireDefaultFilters(const std::vector<std::string>& names, const std::string& where,
+                           const std::string& what) {
+  if (names == DefaultFilterNames()) return;
+  auto joined = [](const std::vector<std::string>& list) {
+    std::string text;
+    for (const std::string& name : list) text += (text.empty() ? "" : ", ") + name;
+    return text.empty() ? std::string("none") : text;
+  };
+  throw std::runtime_error(where + ": " + what + " supports only the filters " +
+                           joined(DefaultFilterNames()) + " (got " + joined(names) + ")");
 }
 
 std::string MapFile(const std::string& filter_name) { return "map_" + filter_name + ".csv"; }
@@ -29,10 +43,20 @@ std::vector<std::string> FilterColumns(const std::string& filter_name) {
   return columns;
 }
 
-std::vector<std::string> TrajectoryColumns() {
+std::vector<std::string> TrajectoryFilterNames(const std::vector<std::string>& columns) {
+  std::vector<std::string> names;
+  for (const std::string& column : columns) {
+    if (column.size() <= 2 || column.compare(column.size() - 2, 2, "_x") != 0) continue;
+    const std::string name = column.substr(0, column.size() - 2);
+    if (name != "true" && name != "odom") names.push_back(name);
+  }
+  return names;
+}
+
+std::vector<std::string> TrajectoryColumns(const std::vector<std::string>& filter_names) {
   std::vector<std::string> columns = RecordedTrajectoryColumns();
   columns.push_back("explored");
-  for (const std::string& name : FilterNames()) {
+  for (const std::string& name : filter_names) {
     for (const std::string& column : FilterColumns(name)) columns.push_back(column);
   }
   return columns;
@@ -52,9 +76,9 @@ std::vector<std::string> MapColumns() {
   return {"id", "type", "p0", "p1", "c00", "c01", "c11", "ax", "ay", "bx", "by"};
 }
 
-std::vector<std::string> NeesColumns() {
+std::vector<std::string> NeesColumns(const std::vector<std::string>& filter_names) {
   std::vector<std::string> columns = {"t"};
-  for (const std::string& name : FilterNames()) columns.push_back(name + "_anees");
+  for (const std::string& name : filter_names) columns.push_back(name + "_anees");
   for (const char* column : {"lower", "upper", "n_runs"}) columns.emplace_back(column);
   return columns;
 }

@@ -28,9 +28,21 @@ inline constexpr char kReferenceFile[] = "reference.csv";
 inline constexpr char kSweepRunsFolder[] = "runs";
 inline constexpr char kNeesFile[] = "nees.csv";
 
-/// The names of the two filters, classical then selective, as in file names
-/// (MapFile) and column prefixes (FilterColumns).
-const std::vector<std::string>& FilterNames();
+/// The names of the default filters (slam.filters absent), classical then
+/// selective, as in file names (MapFile) and column prefixes
+/// (FilterColumns). A run's own are in its trajectory.csv's header
+/// (TrajectoryFilterNames) or config (slam::FilterNamesOf).
+const std::vector<std::string>& DefaultFilterNames();
+
+/// The filters of a trajectory.csv with `columns`: the name of each column
+/// `<name>_x` other than true_x and odom_x, in order (empty: a recording).
+std::vector<std::string> TrajectoryFilterNames(const std::vector<std::string>& columns);
+
+/// For a consumer that supports only the default filters: throws
+/// std::runtime_error "<where>: <what> supports only the filters classical,
+/// selective (got <names>)" unless `names` are DefaultFilterNames().
+void RequireDefaultFilters(const std::vector<std::string>& names, const std::string& where,
+                           const std::string& what);
 
 /// The map file of filter `name`: "map_<name>.csv".
 std::string MapFile(const std::string& filter_name);
@@ -39,9 +51,10 @@ std::string MapFile(const std::string& filter_name);
 std::string PathIn(const std::string& dir, const std::string& file);
 
 /// trajectory.csv: t, the true pose, the odometry pose, the command, the
-/// explored fraction, then FilterColumns() of each filter in the order of
-/// FilterNames().
-std::vector<std::string> TrajectoryColumns();
+/// explored fraction, then FilterColumns() of each filter of
+/// `filter_names`, in order.
+std::vector<std::string> TrajectoryColumns(
+    const std::vector<std::string>& filter_names = DefaultFilterNames());
 /// The recorded columns of trajectory.csv that come first, t .. cmd_w (what
 /// a replay reads).
 std::vector<std::string> RecordedTrajectoryColumns();
@@ -60,9 +73,10 @@ std::vector<std::string> ExplorerColumns();
 /// Map CSVs (map_<filter>.csv, ground_truth_map.csv): id, type, p0, p1,
 /// c00, c01, c11, ax, ay, bx, by (type is text).
 std::vector<std::string> MapColumns();
-/// nees.csv of a sweep: t, classical_anees, selective_anees, lower, upper,
-/// n_runs.
-std::vector<std::string> NeesColumns();
+/// nees.csv of a sweep: t, <name>_anees of each filter (classical_anees,
+/// selective_anees by default), lower, upper, n_runs.
+std::vector<std::string> NeesColumns(
+    const std::vector<std::string>& filter_names = DefaultFilterNames());
 /// reference.csv: t, x, y, th (the pose of R at each scan of an imported log
 /// that carries one).
 std::vector<std::string> ReferenceColumns();

@@ -157,7 +157,8 @@ std::vector<TrajectoryRow> ReadTrajectoryRows(const std::string& path) {
   // The columns after the recorded ones, by name: each known, none twice.
   const std::size_t num_recorded = RecordedTrajectoryColumns().size();
   std::vector<std::string> known = {"explored"};
-  for (const std::string& name : FilterNames()) {
+  const std::vector<std::string> names = TrajectoryFilterNames(table.columns);
+  for (const std::string& name : names) {
     for (const std::string& column : FilterColumns(name)) known.push_back(column);
   }
   std::map<std::string, int> index;
@@ -187,7 +188,7 @@ std::vector<TrajectoryRow> ReadTrajectoryRows(const std::string& path) {
   const std::vector<std::string> optional = {"period", "open_loop", "nees", "processed"};
   std::vector<std::map<std::string, int>> filters;
   if (has_filters) {
-    for (const std::string& name : FilterNames()) {
+    for (const std::string& name : names) {
       filters.emplace_back();
       for (const std::string& suffix : suffixes) {
         const bool may_miss = std::find(optional.begin(), optional.end(), suffix) != optional.end();
@@ -215,6 +216,7 @@ std::vector<TrajectoryRow> ReadTrajectoryRows(const std::string& path) {
       };
       auto count = [&](const char* suffix) { return WholeNumber(table, r, columns.at(suffix), 1e9); };
       FilterRow filter;
+      filter.name = names[row.filters.size()];
       filter.X_WR = Pose2(value("x"), value("y"), value("th"));
       filter.P << value("pxx"), value("pxy"), value("pxth"), value("pxy"), value("pyy"),
           value("pyth"), value("pxth"), value("pyth"), value("pthth");

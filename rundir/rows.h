@@ -17,6 +17,9 @@ namespace mjslam::rundir {
 
 /// One filter's columns of a trajectory.csv row (FilterColumnSuffixes()).
 struct FilterRow {
+  /// The filter's name, the prefix of its columns (set by the reader; the
+  /// writer takes the names from the header it was given).
+  std::string name;
   /// The estimate of R in W after the step, and its 3x3 pose covariance
   /// (x, y, th; metres, radians).
   Pose2 X_WR;
@@ -51,7 +54,7 @@ struct TrajectoryRow {
   /// Explored fraction in [0, 1]; not finite: written as an empty field
   /// (a replay of a recording that has none).
   double explored = 0.0;
-  /// One per filter, in the order of FilterNames().
+  /// One per filter, in the order of the file's columns.
   std::vector<FilterRow> filters;
 };
 
@@ -97,9 +100,10 @@ CsvTable ReadScansCsv(const std::string& path);
 
 /// Reads a trajectory.csv into its rows, the inverse of AddTrajectoryRow:
 /// the checks of ReadTrajectoryCsv (the recorded columns first, in order),
-/// then the other columns of TrajectoryColumns() by name, in any order, none
-/// twice and no other. The filters' columns are there for every filter or
-/// for none (a recording: `filters` empty); "explored" and each filter's
+/// then the other columns of TrajectoryColumns(names) by name, in any order,
+/// none twice and no other, the filters' names those of the columns
+/// `<name>_x` (TrajectoryFilterNames), each with all its columns (none: a
+/// recording, `filters` empty); "explored" and each filter's
 /// "_period", "_open_loop", "_nees" and "_processed" may be missing (runs
 /// from before them): NaN, and processed true. Poses go through Pose2's
 /// constructor (angles wrapped), P is the symmetric matrix of its upper

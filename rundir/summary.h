@@ -31,7 +31,7 @@ struct RunSummary {
 
   /// One filter's end state.
   struct Filter {
-    /// Its name (FilterNames()).
+    /// Its name (DefaultFilterNames()).
     std::string name;
     /// Estimate minus truth of the final pose (x, y metres; th radians,
     /// wrapped).

@@ -7,6 +7,7 @@
 
 #include "common/params.h"
 #include "slam/feature_extraction.h"
+#include "slam/filter_params.h"
 #include "slam/innovation_check.h"
 
 namespace mjslam::slam {
@@ -484,11 +485,16 @@ struct SlamParams {
   /// "every_scan" (every filter processes every record, whatever its
   /// processing time) or "realtime" (a filter busy with a scan for its
   /// command period skips the scans that arrive meanwhile). The string lives
-  /// only here, where YAML is read; app/slam_pair.h turns it into an enum.
+  /// only here, where YAML is read; app/engine/filter_bank.h turns it into an enum.
   std::string timing = "every_scan";
   /// The run's check of each filter against its own innovations
   /// (`slam.innovation_check.*`; InnovationCheck).
   InnovationCheckParams innovation_check;
+  /// The filters of the run, each named, of a kind, with settings of its own
+  /// (`slam.filters`; slam/filter.h). Empty (the key absent): the paper's
+  /// two, classical and selective (ResolvedFilters); the resolved config
+  /// then has no `filters` key either.
+  std::vector<FilterParams> filters;
 
   template <typename Archive>
   void Serialize(Archive* a) {
@@ -496,6 +502,7 @@ struct SlamParams {
     a->Visit(MJSLAM_NVP(ekf));
     a->Visit(MJSLAM_NVP(timing));
     a->Visit(MJSLAM_NVP(innovation_check));
+    if (!ArchiveWrites<Archive>::value || !filters.empty()) a->Visit(MJSLAM_NVP(filters));
   }
   /// Problems of both parts, keys prefixed `features.` and `ekf.`, of
   /// `timing` and of `innovation_check.`.
@@ -505,6 +512,9 @@ struct SlamParams {
     check.Merge("ekf", ekf.Validate());
     check.OneOf("timing", timing, {"every_scan", "realtime"});
     check.Merge("innovation_check", innovation_check.Validate());
+    for (const ParamProblem& p : ValidateFilters(filters)) {
+      check.Require(false, p.key, p.value, p.expected);
+    }
     return check.problems();
   }
   /// Throws ParamError listing every problem of Validate().

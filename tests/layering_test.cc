@@ -21,7 +21,7 @@ namespace fs = std::filesystem;
 // of its own (app/README.md), each a folder here.
 const std::set<std::string> kCodeFolders = {
     "common",  "config",  "sim",       "slam",     "explorer",  "eval",      "rundir",
-    "realdata", "renders", "app/engine", "app/jobs", "app/batch", "app/cli", "fuzz"};
+    "realdata", "renders", "app/engine", "app/jobs", "app/batch", "app/cli", "fuzz", "examples"};
 
 // The project folder of `path` (a header as included, or a file's path
 // relative to the root): "app/<job>" inside app/, else its first component;
@@ -62,6 +62,8 @@ Rule RuleFor(const std::string& folder) {
   if (folder == "common") return {{"common"}, false, false, false, false};
   if (folder == "slam") return {{"common", "slam"}, false, false, false, false};
   if (folder == "explorer") return {{"common", "explorer"}, false, false, false, false};
+  // Filters written against slam/filter.h: what slam/ may use, and slam/.
+  if (folder == "examples") return {{"common", "slam", "examples"}, false, false, false, false};
   if (folder == "eval") return {{"common", "eval"}, false, false, false, false};
   // The run directory's format: common and files. eval/map_types.h is the
   // map feature the map CSVs hold, until one map feature lives in common/.
@@ -164,6 +166,10 @@ TEST(LayeringTest, DetectsForbiddenIncludes) {
   EXPECT_EQ(Violations(app, RuleFor("app/cli")).size(), 1u);
   EXPECT_EQ(Violations(app, RuleFor("fuzz")).size(), 2u);
   EXPECT_EQ(Violations(app, RuleFor("renders")).size(), 5u);
+  // A filter of examples/ is written against slam/ alone: no engine, no files.
+  EXPECT_EQ(Violations(app + "#include <fstream>\n#include \"slam/filter.h\"\n",
+                       RuleFor("examples")).size(),
+            6u);
   // ... and the core folders may not write run directories.
   EXPECT_EQ(Violations("#include <fstream>\n#include \"rundir/layout.h\"\n", RuleFor("eval")).size(),
             2u);

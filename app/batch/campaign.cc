@@ -176,14 +176,32 @@ std::vector<CampaignCell> CampaignCells(const CampaignParams& campaign) {
   return cells;
 }
 
+namespace {
+
+// The filters of the cells' sweeps: each name of a summary's `filters`, in
+// the order first seen (the default filters' when there are none).
+std::vector<std::string> CampaignFilterNames(const std::vector<nlohmann::json>& summaries) {
+  std::vector<std::string> names;
+  for (const nlohmann::json& s : summaries) {
+    if (!s.is_object() || !s.contains("filters") || !s["filters"].is_object()) continue;
+    for (const auto& [name, unused] : s["filters"].items()) {
+      if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
+    }
+  }
+  return names.empty() ? rundir::DefaultFilterNames() : names;
+}
+
+}  // namespace
+
 std::string CampaignTableCsv(const std::vector<CampaignCell>& cells,
                              const std::vector<nlohmann::json>& summaries) {
+  const std::vector<std::string> names = CampaignFilterNames(summaries);
   std::string csv = "cell";
   if (!cells.empty()) {
     for (const auto& [label, value] : cells.front().labels) csv += "," + rundir::CsvField(label);
   }
   csv += ",runs";
-  for (const std::string& f : rundir::FilterNames()) {
+  for (const std::string& f : names) {
     for (const FilterColumn& column : kFilterColumns) csv += "," + f + "_" + column.name;
     csv += "," + f + "_verdict";
   }
@@ -193,7 +211,7 @@ std::string CampaignTableCsv(const std::vector<CampaignCell>& cells,
     csv += rundir::CsvField(cells[c].name);
     for (const auto& [label, value] : cells[c].labels) csv += "," + rundir::CsvField(value);
     csv += "," + std::to_string(s["sweep"].value("completed_runs", 0));
-    for (const std::string& f : rundir::FilterNames()) {
+    for (const std::string& f : names) {
       for (const FilterColumn& column : kFilterColumns) {
         csv += "," + rundir::FormatDouble(NumberAt(s, "/filters/" + f + column.pointer));
       }
@@ -206,6 +224,7 @@ std::string CampaignTableCsv(const std::vector<CampaignCell>& cells,
 
 std::string CampaignTableText(const std::vector<CampaignCell>& cells,
                               const std::vector<nlohmann::json>& summaries) {
+  const std::vector<std::string> names = CampaignFilterNames(summaries);
   // Column widths: the longest cell name.
   std::size_t width = 4;
   for (const CampaignCell& cell : cells) width = std::max(width, cell.name.size());
@@ -214,7 +233,7 @@ std::string CampaignTableText(const std::vector<CampaignCell>& cells,
   std::string text;
   std::snprintf(line, sizeof(line), "%-*s %5s", w, "cell", "runs");
   text += line;
-  for (const std::string& f : rundir::FilterNames()) {
+  for (const std::string& f : names) {
     std::snprintf(line, sizeof(line), "  %10.10s in   ANEES verdict       ", f.c_str());
     text += line;
   }
@@ -224,7 +243,7 @@ std::string CampaignTableText(const std::vector<CampaignCell>& cells,
     std::snprintf(line, sizeof(line), "%-*s %5d", w, cells[c].name.c_str(),
                   s["sweep"].value("completed_runs", 0));
     text += line;
-    for (const std::string& f : rundir::FilterNames()) {
+    for (const std::string& f : names) {
       std::snprintf(line, sizeof(line), "  %13.3f %7.3f %-14s",
                     NumberAt(s, "/filters/" + f + "/fraction_inside"),
                     NumberAt(s, "/filters/" + f + "/mean_anees"),

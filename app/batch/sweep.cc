@@ -26,7 +26,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using rundir::CsvTable;
-using rundir::FilterNames;
 using rundir::FormatDouble;
 using rundir::PathIn;
 using rundir::ReadJsonFile;
@@ -399,6 +398,8 @@ nlohmann::json MeanOf(const std::vector<nlohmann::json>& summaries, const nlohma
 // What the aggregate reads of each run: per filter and run the NEES of every
 // step and the time totals; per run the times and the summary.
 struct SweepRuns {
+  // The filters of the runs (each run's trajectory.csv has the same).
+  std::vector<std::string> names;
   std::vector<std::vector<std::vector<double>>> nees;
   std::vector<std::vector<double>> times;
   std::vector<std::vector<double>> processing_s;
@@ -410,9 +411,35 @@ struct SweepRuns {
   std::vector<nlohmann::json> summaries;
 };
 
+// The filters of the runs: those of the first run's trajectory.csv (the
+// default ones without runs); a run with other filters is an error naming
+// both lists.
+std::vector<std::string> SweepFilterNames(const std::vector<std::string>& run_dirs) {
+  std::vector<std::string> names = rundir::DefaultFilterNames();
+  for (std::size_t r = 0; r < run_dirs.size(); ++r) {
+    const std::string path = PathIn(run_dirs[r], rundir::kTrajectoryFile);
+    const std::vector<std::string> run_names =
+        rundir::TrajectoryFilterNames(rundir::ReadCsv(path).columns);
+    if (r == 0) {
+      names = run_names;
+    } else if (run_names != names) {
+      auto joined = [](const std::vector<std::string>& list) {
+        std::string text;
+        for (const std::string& name : list) text += (text.empty() ? "" : ", ") + name;
+        return text;
+      };
+      throw std::runtime_error(path + ": filters " + joined(run_names) + ", not those of " +
+                               PathIn(run_dirs[0], rundir::kTrajectoryFile) + " (" +
+                               joined(names) + "): a sweep's runs must have the same filters");
+    }
+  }
+  return names;
+}
+
 SweepRuns ReadSweepRuns(const std::vector<std::string>& run_dirs) {
-  const std::vector<std::string>& names = FilterNames();
   SweepRuns runs;
+  runs.names = SweepFilterNames(run_dirs);
+  const std::vector<std::string>& names = runs.names;
   runs.nees.resize(names.size());
   runs.processing_s.resize(names.size());
   runs.open_loop_s.resize(names.size());
@@ -471,10 +498,10 @@ struct NeesCounts {
 // that many runs; written to out_dir/nees.csv.
 NeesCounts WriteAverageNees(const SweepRuns& runs, const std::string& out_dir,
                             const SweepOptions& options) {
-  const std::size_t num_filters = FilterNames().size();
+  const std::size_t num_filters = runs.names.size();
   std::size_t num_steps = 0;
   for (const std::vector<double>& run_times : runs.times) num_steps = std::max(num_steps, run_times.size());
-  std::string csv = rundir::HeaderLine(rundir::NeesColumns());
+  std::string csv = rundir::HeaderLine(rundir::NeesColumns(runs.names));
   NeesCounts counts{std::vector<int>(num_filters, 0), std::vector<int>(num_filters, 0),
                     std::vector<int>(num_filters, 0), std::vector<double>(num_filters, 0.0), 0};
   for (std::size_t k = 0; k < num_steps; ++k) {
@@ -515,7 +542,7 @@ NeesCounts WriteAverageNees(const SweepRuns& runs, const std::string& out_dir,
 // runs' own metrics.
 nlohmann::json FilterAggregate(std::size_t f, const SweepRuns& runs, const NeesCounts& counts,
                                const SweepOptions& options) {
-  const std::string& name = FilterNames()[f];
+  const std::string& name = runs.names[f];
   const std::size_t num_runs = runs.times.size();
   const int used_steps = counts.used_steps;
   auto mean = [](const std::vector<double>& v) {
@@ -589,8 +616,8 @@ nlohmann::json AggregateSweep(const std::vector<std::string>& run_dirs, const st
                       {"steps", counts.used_steps},
                       {"bounds", {{"probability", options.bounds_probability}, {"dof", 3}}},
                       {"min_fraction_inside", options.min_fraction_inside}};
-  for (std::size_t f = 0; f < FilterNames().size(); ++f) {
-    summary["filters"][FilterNames()[f]] = FilterAggregate(f, runs, counts, options);
+  for (std::size_t f = 0; f < runs.names.size(); ++f) {
+    summary["filters"][runs.names[f]] = FilterAggregate(f, runs, counts, options);
   }
   // The mean of the runs' divergences, when they were evaluated with one.
   for (const char* pair : {"classical_selective", "selective_classical", "classical_truth",

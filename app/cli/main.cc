@@ -142,7 +142,13 @@ int RunMain(const CLI::App& run, RunCommand c, const std::string& command_line) 
     std::printf("%s", PhaseCpuReport(result.cpu, result.sim_time_s, ProcessCpuSeconds()).c_str());
   }
   if (result.status != "completed") return 130;
-  if (!c.no_evaluate) EvaluateRunDirectory(options.out_dir, EvaluateOptions{});
+  if (!c.no_evaluate) {
+    const RunEvaluation evaluation = EvaluateRunDirectory(options.out_dir, EvaluateOptions{});
+    if (!evaluation.no_divergence.empty()) {
+      std::fprintf(stderr, "note: no divergence in summary.json: %s\n",
+                   evaluation.no_divergence.c_str());
+    }
+  }
   if (render) {
     RenderOptions render_options;
     render_options.show_progress = !c.quiet;
@@ -377,7 +383,7 @@ int EvaluateImportedMain(const std::string& run_dir) {
   for (std::size_t f = 0; f < result.num_features.size(); ++f) {
     std::printf("%s: %d features; pose covariance not positive semi-definite in %d rows, "
                 "singular in %d\n",
-                rundir::FilterNames()[f].c_str(), result.num_features[f],
+                rundir::DefaultFilterNames()[f].c_str(), result.num_features[f],
                 result.not_positive_semidefinite[f], result.singular[f]);
   }
   return 0;
@@ -392,7 +398,7 @@ int EvaluateMain(const EvaluateCommand& c) {
     const auto& p = result.pose[i];
     const auto& m = result.map[i];
     std::printf("%-10s %8.3f %8.3f %8.3f %9.3f %8.3f %9d %6d %6d\n",
-                rundir::FilterNames()[i].c_str(), p.inside_2sigma(0), p.inside_2sigma(1),
+                result.names[i].c_str(), p.inside_2sigma(0), p.inside_2sigma(1),
                 p.inside_2sigma(2), p.mean_nees, m.matched_fraction, m.num_duplicates,
                 m.num_unmatched_estimates, m.num_inconsistent);
   }
@@ -401,6 +407,9 @@ int EvaluateMain(const EvaluateCommand& c) {
               "(2 if the extractor's covariances hold), above 9.21: %.4f, largest %.1f, "
               "range bias %.4f m removed\n",
               o.matched, o.lines, o.mean_nis, o.fraction_above_gate, o.max_nis, o.range_bias_m);
+  if (!result.no_divergence.empty()) {
+    std::printf("no divergence: %s\n", result.no_divergence.c_str());
+  }
   if (result.has_divergence) {
     std::printf("divergence: classical||selective %.4g, selective||classical %.4g, "
                 "classical||truth %.4g, selective||truth %.4g\n",
@@ -503,8 +512,7 @@ void PrintSweep(const SweepResult& result) {
     std::fputs(result.table.c_str(), stdout);
     return;
   }
-  for (const std::string& name : rundir::FilterNames()) {
-    const auto& f = result.summary["filters"][name];
+  for (const auto& [name, f] : result.summary["filters"].items()) {
     std::printf("%-10s ANEES inside the bounds for %.3f of the steps (above %.3f, below "
                 "%.3f), mean ANEES %.3f: %s\n",
                 name.c_str(), f["fraction_inside"].get<double>(), f["fraction_above"].get<double>(),

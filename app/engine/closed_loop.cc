@@ -14,17 +14,6 @@
 #include "sim/wheel_odometry.h"
 
 namespace mjslam::app {
-namespace {
-
-// Index of the filter that drives the robot, or -1 (odometry, ground truth).
-int DrivingFilter(const std::string& pose_source) {
-  if (pose_source == "classical") return 0;
-  if (pose_source == "selective") return 1;
-  return -1;
-}
-
-}  // namespace
-
 // The simulated world of the loop and what it measures of the run.
 struct ClosedLoop::World {
   World(const RunConfig& config, const Rng& run_rng)
@@ -69,14 +58,15 @@ ClosedLoop::ClosedLoop(const RunConfig& config)
   const double a_m = config_.robot.control_point_offset_m;
   if (config_.control.driver == "explorer") {
     w.explorer.emplace(config_.explorer, a_m);
-    w.driving_filter = DrivingFilter(config_.control.pose_source);
   } else {
     std::vector<Eigen::Vector2d> waypoints;
     for (const auto& p : config_.driver.waypoints) waypoints.emplace_back(p[0], p[1]);
     if (waypoints.empty()) waypoints = w.simulator.scene().TourWaypoints();
     w.tour.emplace(config_.driver, waypoints, a_m);
   }
-  slam_.emplace(config_.slam, config_.control, dt_s_, X_WR0_, X_RS_, Rng(config_.run.seed));
+  filters_.emplace(config_.slam, config_.control, dt_s_, X_WR0_, X_RS_, Rng(config_.run.seed));
+  // The filter whose pose the explorer navigates with (-1: odometry, truth).
+  if (w.explorer) w.driving_filter = filters_->IndexOf(config_.control.pose_source);
   w.coverage.emplace(w.simulator.scene().Obstacles(), (X_WR0_ * Pose2(-a_m, 0.0, 0.0)).translation());
   last_step_ = static_cast<int>(
       std::floor(config_.run.duration_s * config_.run.control_rate_hz + 1e-9));
@@ -91,7 +81,7 @@ ClosedLoop::ClosedLoop(const RunConfig& config, const rundir::Recording& recordi
   const Pose2& X_WR0 = has_truth ? first.X_WR_true : first.X_WR_odometry;
   X_WR0_ = Pose2(X_WR0.x, X_WR0.y, X_WR0.theta);
   X_RS_ = recording.X_RS();
-  slam_.emplace(config_.slam, config_.control, dt_s_, X_WR0_, X_RS_, Rng(config_.run.seed));
+  filters_.emplace(config_.slam, config_.control, dt_s_, X_WR0_, X_RS_, Rng(config_.run.seed));
   last_step_ = static_cast<int>(recording.num_steps()) - 1;
 }
 
@@ -109,7 +99,7 @@ const LoopStep& ClosedLoop::Step() {
   out_.index = step_;
   // What the robot reports: odometry, the command it held, maybe a scan.
   Sense();
-  // Both filters on the same record.
+  // Every filter on the same record.
   RunFilters();
   // The driver's command, held for the driving filter's command period.
   Drive();
@@ -200,9 +190,9 @@ void ClosedLoop::ReadRecording() {
 }
 
 void ClosedLoop::RunFilters() {
-  slam_->Step(out_.record);
+  filters_->Step(out_.record);
   const Pose2& X_WR = out_.row.X_WR_true;
-  out_.row.filters = slam_->Rows(Pose2(X_WR.x, X_WR.y, X_WR.theta));
+  out_.row.filters = filters_->Rows(Pose2(X_WR.x, X_WR.y, X_WR.theta));
   laps_.Charge(&cpu_.filters_s);
 }
 
@@ -222,7 +212,7 @@ void ClosedLoop::Drive() {
 void ClosedLoop::DriveInWorld() {
   if (step_ < next_command_step_) return;
   World& w = *world_;
-  const int period_steps = w.driving_filter >= 0 ? slam_->period_steps(w.driving_filter) : 1;
+  const int period_steps = w.driving_filter >= 0 ? filters_->period_steps(w.driving_filter) : 1;
   next_command_step_ = step_ + period_steps;
   const double t = out_.record.t_s;
   const Pose2& X_WR = out_.row.X_WR_true;
@@ -230,7 +220,7 @@ void ClosedLoop::DriveInWorld() {
   if (w.explorer) {
     Pose2 X_WR_used = X_WR;
     if (w.driving_filter >= 0) {
-      X_WR_used = slam_->filter(w.driving_filter).X_WR();
+      X_WR_used = filters_->filter(w.driving_filter).X_WR();
     } else if (config_.control.pose_source == "odometry") {
       X_WR_used = out_.record.X_OR;
     }
@@ -293,19 +283,19 @@ rundir::RunSummary ClosedLoop::Summary(bool interrupted) const {
   summary.t_explored_90_s = w.t90;
   summary.t_explored_99_s = w.t99;
   const Pose2 X_WR_end = w.simulator.X_WR();
-  for (int f = 0; f < 2; ++f) {
-    const Pose2 X_WR_estimate = slam_->filter(f).X_WR();
+  for (int f = 0; f < filters_->size(); ++f) {
+    const Pose2 X_WR_estimate = filters_->filter(f).X_WR();
     rundir::RunSummary::Filter filter;
-    filter.name = slam_->name(f);
+    filter.name = filters_->name(f);
     filter.error_x = X_WR_estimate.x - X_WR_end.x;
     filter.error_y = X_WR_estimate.y - X_WR_end.y;
     filter.error_th = WrapAngle(X_WR_estimate.theta - X_WR_end.theta);
-    filter.num_features = slam_->filter(f).num_features();
-    filter.processing_s = slam_->total_processing_s(f);
-    filter.open_loop_s = slam_->open_loop_s(f);
-    filter.scans_processed = slam_->scans_processed(f);
-    filter.scans_skipped = slam_->scans_skipped(f);
-    const slam::InnovationCheckResult check = slam_->innovation_check(f);
+    filter.num_features = filters_->filter(f).num_features();
+    filter.processing_s = filters_->total_processing_s(f);
+    filter.open_loop_s = filters_->open_loop_s(f);
+    filter.scans_processed = filters_->scans_processed(f);
+    filter.scans_skipped = filters_->scans_skipped(f);
+    const slam::InnovationCheckResult check = filters_->innovation_check(f);
     filter.innovation_windows = check.windows;
     filter.innovation_failed_windows = check.failed_windows;
     filter.innovation_longest_failed_streak = check.longest_failed_streak;

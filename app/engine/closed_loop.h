@@ -6,7 +6,7 @@
 
 #include "app/engine/cpu_profile.h"
 #include "app/engine/run_config.h"
-#include "app/engine/slam_pair.h"
+#include "app/engine/filter_bank.h"
 #include "common/records.h"
 #include "explorer/explorer.h"
 #include "rundir/recording.h"
@@ -20,12 +20,12 @@ namespace mjslam::app {
 struct LoopStep {
   /// Index of the control step, from 0.
   int index = 0;
-  /// The record both filters ran on (time, odometry, held command, scan).
+  /// The record every filter ran on (time, odometry, held command, scan).
   SensorRecord record;
   /// True pose of the laser S in W at the step (simulated loop only).
   Pose2 X_WS_true;
   /// The step's row of trajectory.csv: truth, odometry, the command applied
-  /// from now on, the explored fraction and both filters' columns.
+  /// from now on, the explored fraction and every filter's columns.
   rundir::TrajectoryRow row;
   /// The explorer's sets changed in this step (explorer.csv gets rows).
   bool explorer_changed = false;
@@ -35,8 +35,8 @@ struct LoopStep {
 };
 
 /// The closed loop of `mjslam run` and `mjslam replay`: a source of records
-/// (the simulator, or a recording of an earlier run), the two filters
-/// (SlamPair), the driver (the frontier explorer or the tour; a recording
+/// (the simulator, or a recording of an earlier run), the run's filters
+/// (FilterBank), the driver (the frontier explorer or the tour; a recording
 /// brings its own commands) and the clock (control steps, the command held
 /// for the driving filter's command period). One Step() reads like the data
 /// flow: sense, filter, drive, advance. Writes no files: its callers hand
@@ -51,7 +51,7 @@ class ClosedLoop {
   /// run.duration_s of steps. Throws what the simulator throws (sim::SimError)
   /// for a bad world or robot; `config` must be valid.
   explicit ClosedLoop(const RunConfig& config);
-  /// The recorded loop: both filters on the records rebuilt from
+  /// The recorded loop: the filters on the records rebuilt from
   /// `recording` (true start pose, or the first odometry pose of a recording
   /// without truth such as an imported log; odometry, held commands, scans laid out
   /// as config.laser says; ranges at the maximum are no-return). `recording`
@@ -71,8 +71,8 @@ class ClosedLoop {
   int num_steps() const { return last_step_ + 1; }
   /// The laser mount X_RS on R.
   const Pose2& X_RS() const { return X_RS_; }
-  /// The two filters.
-  const SlamPair& slam() const { return *slam_; }
+  /// The run's filters.
+  const FilterBank& filters() const { return *filters_; }
   /// The explorer when it drives, else null.
   const explorer::Explorer* explorer() const;
   /// The simulated run so far (simulated loop only): distance, contacts,
@@ -99,7 +99,7 @@ class ClosedLoop {
   const RunConfig config_;
   std::unique_ptr<World> world_;                     // simulated loop
   const rundir::Recording* recording_ = nullptr;     // recorded loop
-  std::optional<SlamPair> slam_;
+  std::optional<FilterBank> filters_;
   Pose2 X_WR0_;
   Pose2 X_RS_;
 

@@ -8,7 +8,8 @@ namespace mjslam::app {
 std::vector<ParamProblem> ControlParams::Validate() const {
   ParamChecker check;
   check.OneOf("driver", driver, {"explorer", "tour"});
-  check.OneOf("pose_source", pose_source, {"selective", "classical", "odometry", "ground_truth"});
+  // pose_source (a filter's name, odometry or ground_truth): checked by
+  // RunConfig::Validate, which knows the filters' names.
   check.OneOf("processing", processing, {"model", "measured"});
   check.Positive("measured_time_factor", measured_time_factor);
   check.NonNegative("model_base_s", model_base_s);

@@ -14,8 +14,9 @@ struct ControlParams {
   /// "explorer" (the frontier explorer, closed loop) or "tour" (the built-in
   /// waypoint driver along the world's tour, from the true pose).
   std::string driver = "explorer";
-  /// The pose the explorer navigates with: "selective", "classical",
-  /// "odometry" or "ground_truth". Both filters always run.
+  /// The pose the explorer navigates with: a filter's name (slam.filters;
+  /// by default "selective" or "classical"), "odometry" or "ground_truth".
+  /// Every filter always runs.
   std::string pose_source = "selective";
   /// Where a filter's processing time per step comes from: "model" (the
   /// deterministic cost model below, bit-reproducible) or "measured" (the

@@ -22,7 +22,7 @@ struct PhaseCpu {
   double odometry_s = 0.0;
   /// The explored fraction: TrueCoverage::Observe and ExploredFraction.
   double coverage_s = 0.0;
-  /// Both filters' own steps (SlamPair::Step) and their trajectory.csv
+  /// The filters' own steps (FilterBank::Step) and their trajectory.csv
   /// columns.
   double filters_s = 0.0;
   /// The driver: the explorer (or the tour) and SetCommand.

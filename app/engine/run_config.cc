@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include "config/config.h"
+#include "slam/filter.h"
 
 namespace mjslam::app {
 namespace {
@@ -48,6 +49,10 @@ std::vector<ParamProblem> RunConfig::Validate() const {
                   "a rate that divides run.control_rate_hz (" +
                       ValueText(run.control_rate_hz) + ")");
   }
+  // The explorer navigates with one filter's pose, the odometry or the truth.
+  std::vector<std::string> sources = slam::FilterNamesOf(slam);
+  sources.insert(sources.end(), {"odometry", "ground_truth"});
+  check.OneOf("control.pose_source", control.pose_source, sources);
   // The filters predict the point h that the robot is driven by.
   check.Require(slam.ekf.control_point_offset_m == robot.control_point_offset_m,
                 "slam.ekf.control_point_offset_m", slam.ekf.control_point_offset_m,

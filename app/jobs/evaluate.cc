@@ -5,7 +5,9 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <stdexcept>
+#include <utility>
 
 #include "app/engine/cpu_profile.h"  // CpuLaps
 #include "app/engine/run_config.h"
@@ -25,7 +27,6 @@ namespace mjslam::app {
 namespace {
 
 using rundir::CsvTable;
-using rundir::FilterNames;
 
 nlohmann::json Xyz(const Eigen::Vector3d& v) {
   return {{"x", v(0)}, {"y", v(1)}, {"th", v(2)}};
@@ -36,19 +37,58 @@ nlohmann::json Number(double value) {
   return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(nullptr);
 }
 
-// eval::DivergenceStudy of a run's maps; its errors (a map with nothing to
-// compare) name the run's map files and its world.
+// The columns of the header line of CSV file `path` (empty when it cannot
+// be read).
+std::vector<std::string> HeaderColumns(const std::string& path) {
+  std::ifstream in(path);
+  std::string line;
+  std::getline(in, line);
+  if (!line.empty() && line.back() == '\r') line.pop_back();
+  std::vector<std::string> columns;
+  std::stringstream fields(line);
+  for (std::string field; std::getline(fields, field, ',');) columns.push_back(field);
+  return columns;
+}
+
+// Why the map divergence cannot be computed for a run with filters `names`
+// (it compares the filters classical and selective), or "" when it can.
+std::string NoDivergencePair(const std::vector<std::string>& names, const std::string& run_dir) {
+  const std::vector<std::string>& pair = rundir::DefaultFilterNames();
+  if (std::find(names.begin(), names.end(), pair[0]) != names.end() &&
+      std::find(names.begin(), names.end(), pair[1]) != names.end()) {
+    return "";
+  }
+  std::string got;
+  for (const std::string& name : names) got += (got.empty() ? "" : ", ") + name;
+  return rundir::PathIn(run_dir, rundir::kTrajectoryFile) +
+         ": the map divergence compares the filters " + pair[0] + " and " + pair[1] + " (got " +
+         (got.empty() ? "none" : got) + ")";
+}
+
+// The indices of the classical and selective filters among `names`, the
+// pair the map divergence compares; NoDivergencePair must be "".
+std::pair<std::size_t, std::size_t> DivergencePair(const std::vector<std::string>& names) {
+  const std::vector<std::string>& pair = rundir::DefaultFilterNames();
+  return {static_cast<std::size_t>(std::find(names.begin(), names.end(), pair[0]) - names.begin()),
+          static_cast<std::size_t>(std::find(names.begin(), names.end(), pair[1]) - names.begin())};
+}
+
+// eval::DivergenceStudy of a run's classical and selective maps; its errors
+// (a map with nothing to compare) name the run's map files and its world.
 std::vector<eval::DivergenceStatistics> StudyRunMaps(const std::string& run_dir,
-                                                     const std::vector<eval::Map>& maps,
+                                                     const eval::Map& classical,
+                                                     const eval::Map& selective,
                                                      const eval::Map& truth,
                                                      const std::vector<int>& num_points,
                                                      int realisations, const Rng& rng,
                                                      const eval::DivergenceParams& params) {
+  const std::vector<std::string>& names = rundir::DefaultFilterNames();
   try {
-    return eval::DivergenceStudy(maps[0], maps[1], truth, num_points, realisations, rng, params);
+    return eval::DivergenceStudy(classical, selective, truth, num_points, realisations, rng,
+                                 params);
   } catch (const std::invalid_argument& error) {
-    throw std::runtime_error(rundir::PathIn(run_dir, rundir::MapFile(FilterNames()[0])) + ", " +
-                             rundir::MapFile(FilterNames()[1]) + " and the ground truth of " +
+    throw std::runtime_error(rundir::PathIn(run_dir, rundir::MapFile(names[0])) + ", " +
+                             rundir::MapFile(names[1]) + " and the ground truth of " +
                              rundir::kConfigFile + "'s world: " + error.what());
   }
 }
@@ -147,9 +187,13 @@ RunEvaluation EvaluateRunDirectory(const std::string& run_dir, const EvaluateOpt
       LoadRunConfig(rundir::PathIn(run_dir, rundir::kConfigFile), {}), result.truth);
   laps.Charge(&result.cpu.observations_s);
 
-  // Poses and maps of both filters.
+  // Poses and maps of every filter of the trajectory.
+  result.names = rundir::TrajectoryFilterNames(trajectory.columns);
+  if (result.names.empty()) {
+    throw std::runtime_error(trajectory.path + ": no filter columns (<name>_x, ...)");
+  }
   std::vector<eval::Map> maps;
-  for (const std::string& name : FilterNames()) {
+  for (const std::string& name : result.names) {
     ThrowIfInterrupted("evaluation");
     std::vector<eval::PoseStepMetrics> steps = PoseSteps(trajectory, name);
     const std::vector<double> nees = PoseNees(trajectory, name);
@@ -160,11 +204,13 @@ RunEvaluation EvaluateRunDirectory(const std::string& run_dir, const EvaluateOpt
     result.map.push_back(eval::MatchMaps(maps.back(), result.truth, options.match));
     laps.Charge(&result.cpu.maps_s);
   }
-  if (options.divergence_points > 0) {
+  result.no_divergence = options.divergence_points > 0 ? NoDivergencePair(result.names, run_dir) : "";
+  if (options.divergence_points > 0 && result.no_divergence.empty()) {
     const std::uint64_t seed = manifest.value("seed", std::uint64_t{0});
+    const auto [classical, selective] = DivergencePair(result.names);
     const std::vector<eval::DivergenceStatistics> rows = StudyRunMaps(
-        run_dir, maps, result.truth, {options.divergence_points}, options.divergence_realisations,
-        Rng(seed).Fork("evaluate"), options.divergence);
+        run_dir, maps[classical], maps[selective], result.truth, {options.divergence_points},
+        options.divergence_realisations, Rng(seed).Fork("evaluate"), options.divergence);
     result.has_divergence = true;
     result.divergence = {rows[0].mean, rows[1].mean, rows[2].mean, rows[3].mean};
     laps.Charge(&result.cpu.divergence_s);
@@ -172,8 +218,8 @@ RunEvaluation EvaluateRunDirectory(const std::string& run_dir, const EvaluateOpt
 
   // Merge into summary.json.
   nlohmann::json summary = rundir::ReadSummary(run_dir);
-  for (std::size_t i = 0; i < FilterNames().size(); ++i) {
-    nlohmann::json& f = summary["filters"][FilterNames()[i]];
+  for (std::size_t i = 0; i < result.names.size(); ++i) {
+    nlohmann::json& f = summary["filters"][result.names[i]];
     const eval::PoseSummary& pose = result.pose[i];
     const eval::MapMatchReport& map = result.map[i];
     f["inside_2sigma"] = Xyz(pose.inside_2sigma);
@@ -219,15 +265,24 @@ std::vector<eval::DivergenceStatistics> WriteDivergenceStudy(
     const std::string& run_dir, const std::vector<int>& num_points, int realisations,
     const std::string& out_path, const EvaluateOptions& options) {
   const nlohmann::json manifest = rundir::ReadManifest(run_dir);
-  const eval::Map truth = RunGroundTruth(run_dir, options.ground_truth);
-  std::vector<eval::Map> maps;
-  for (const std::string& name : FilterNames()) {
-    maps.push_back(rundir::ReadMapCsv(rundir::PathIn(run_dir, rundir::MapFile(name))));
+  // The classical and selective filters of the run (its trajectory's header).
+  const std::string trajectory_path = rundir::PathIn(run_dir, rundir::kTrajectoryFile);
+  std::vector<std::string> names;
+  if (std::filesystem::exists(trajectory_path)) {
+    names = rundir::TrajectoryFilterNames(HeaderColumns(trajectory_path));
+  } else {
+    names = rundir::DefaultFilterNames();  // maps alone: the default filters'
   }
+  const std::string no_pair = NoDivergencePair(names, run_dir);
+  if (!no_pair.empty()) throw std::runtime_error(no_pair);
+  const eval::Map truth = RunGroundTruth(run_dir, options.ground_truth);
+  const std::vector<std::string>& pair = rundir::DefaultFilterNames();
+  const eval::Map classical = rundir::ReadMapCsv(rundir::PathIn(run_dir, rundir::MapFile(pair[0])));
+  const eval::Map selective = rundir::ReadMapCsv(rundir::PathIn(run_dir, rundir::MapFile(pair[1])));
   const std::uint64_t seed = manifest.value("seed", std::uint64_t{0});
   const std::vector<eval::DivergenceStatistics> rows =
-      StudyRunMaps(run_dir, maps, truth, num_points, realisations, Rng(seed).Fork("divergence"),
-                   options.divergence);
+      StudyRunMaps(run_dir, classical, selective, truth, num_points, realisations,
+                   Rng(seed).Fork("divergence"), options.divergence);
   std::string text = rundir::HeaderLine(rundir::DivergenceColumns());
   for (const eval::DivergenceStatistics& row : rows) {
     text += std::to_string(row.num_points) + "," + row.pair + "," + rundir::FormatDouble(row.mean) +

@@ -48,16 +48,20 @@ struct EvaluationCpu {
   double total_s = 0.0;
 };
 
-/// What EvaluateRunDirectory found, per filter in the order of
-/// rundir::FilterNames().
+/// What EvaluateRunDirectory found, per filter in the order of `names`.
 struct RunEvaluation {
+  /// The run's filters, from its trajectory.csv's header.
+  std::vector<std::string> names;
   eval::Map truth;
   std::vector<eval::PoseSummary> pose;
   std::vector<eval::MapMatchReport> map;
   /// The scans' line observations against the true walls.
   ObservationCheck observations;
-  /// Set when divergence_points > 0.
+  /// Set when divergence_points > 0 and the run has the filters classical
+  /// and selective, the pair the divergence compares; else, with
+  /// divergence_points > 0, `no_divergence` says why there is none.
   bool has_divergence = false;
+  std::string no_divergence;
   eval::MapDivergences divergence;
   /// Where the evaluation's CPU time went.
   EvaluationCpu cpu;

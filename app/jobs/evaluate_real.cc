@@ -27,10 +27,9 @@ using realdata::TimedPose;
 // file when it has none (a trajectory written by the import, before its
 // replay).
 void RequireFilters(const std::vector<rundir::TrajectoryRow>& trajectory, const std::string& path) {
-  if (trajectory.front().filters.size() != rundir::FilterNames().size()) {
-    throw std::runtime_error(path + ": no filter columns (" + rundir::FilterNames().front() +
-                             "_x, ...)");
-  }
+  std::vector<std::string> names;
+  for (const rundir::FilterRow& f : trajectory.front().filters) names.push_back(f.name);
+  rundir::RequireDefaultFilters(names, path, "the evaluation of an imported log");
 }
 
 // The poses of the robot centre B of the trajectory `track` (0 odometry, 1 +
@@ -73,7 +72,7 @@ nlohmann::json ToJson(const std::vector<ScoredTrajectory>& scored) {
 }
 
 // Counts the rows whose pose covariance of filter `filter` (in the order of
-// FilterNames()) is not positive semi-definite, and those where it is
+// DefaultFilterNames()) is not positive semi-definite, and those where it is
 // singular (the file holds the upper triangle: symmetric by construction).
 std::pair<int, int> CovarianceDefects(const std::vector<rundir::TrajectoryRow>& trajectory,
                                       std::size_t filter) {
@@ -194,12 +193,12 @@ RealEvaluation EvaluateImportedRun(const std::string& run_dir) {
       result.vs_reference_lags.push_back(scored);
     }
   }
-  for (std::size_t f = 0; f < rundir::FilterNames().size(); ++f) {
+  for (std::size_t f = 0; f < rundir::DefaultFilterNames().size(); ++f) {
     const auto [not_psd, singular] = CovarianceDefects(trajectory, f);
     result.not_positive_semidefinite.push_back(not_psd);
     result.singular.push_back(singular);
     result.num_features.push_back(static_cast<int>(
-        rundir::ReadMapCsv(rundir::PathIn(run_dir, rundir::MapFile(rundir::FilterNames()[f])))
+        rundir::ReadMapCsv(rundir::PathIn(run_dir, rundir::MapFile(rundir::DefaultFilterNames()[f])))
             .size()));
   }
 

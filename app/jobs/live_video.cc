@@ -5,8 +5,9 @@
 
 #include "app/jobs/scene_frame.h"
 #include "sim/scene.h"
-#include "app/engine/slam_pair.h"
+#include "app/engine/filter_bank.h"
 #include "rundir/layout.h"
+#include "slam/filter.h"
 
 namespace mjslam::app {
 LiveVideo::LiveVideo(const RunConfig& config, const std::string& run_dir)
@@ -17,16 +18,16 @@ LiveVideo::LiveVideo(const RunConfig& config, const std::string& run_dir)
              config.render.height, config.render.fps, config.render.crf) {
   min_step_m_ = PixelSizeM(renderer_);
   frame_.ellipse_scale = params_.ellipse_scale;
-  frame_.filters = FilterLayers();
+  frame_.filters = FilterLayers(slam::FilterNamesOf(config.slam));
 }
 
-void LiveVideo::Step(double t_s, const Pose2& X_WR_true, const SlamPair& slam,
+void LiveVideo::Step(double t_s, const Pose2& X_WR_true, const FilterBank& slam,
                      const LaserScan* scan, const Pose2& X_WS,
                      const explorer::Explorer* explorer) {
   frame_.t_s = t_s;
   frame_.X_WR_true = X_WR_true;
   AppendPathPoint(&frame_.true_path, X_WR_true.translation(), min_step_m_);
-  for (int i = 0; i < 2; ++i) {
+  for (int i = 0; i < slam.size(); ++i) {
     renders::FilterLayer& layer = frame_.filters[i];
     const Pose2 X_WR = slam.filter(i).X_WR();
     AppendPathPoint(&layer.path, X_WR.translation(), min_step_m_);
@@ -41,7 +42,7 @@ void LiveVideo::Step(double t_s, const Pose2& X_WR_true, const SlamPair& slam,
 
   // A frame is due: the maps and the explorer as they are now.
   const auto start = std::chrono::steady_clock::now();
-  for (int i = 0; i < 2; ++i) SetMapLayer(slam.filter(i).Map(), &frame_.filters[i]);
+  for (int i = 0; i < slam.size(); ++i) SetMapLayer(slam.filter(i).Map(), &frame_.filters[i]);
   frame_.explorer.reset();
   if (explorer != nullptr) {
     renders::ExplorerLayer layer;

@@ -5,7 +5,7 @@
 #include <string>
 
 #include "app/engine/run_config.h"
-#include "app/engine/slam_pair.h"
+#include "app/engine/filter_bank.h"
 #include "common/laser_scan.h"
 #include "explorer/explorer.h"
 #include "renders/scene_renderer.h"
@@ -22,10 +22,10 @@ class LiveVideo {
  public:
   LiveVideo(const RunConfig& config, const std::string& run_dir);
 
-  /// Records the step at time `t_s` (true pose of R, both filters, the
+  /// Records the step at time `t_s` (true pose of R, the filters, the
   /// scan of the step at the true laser pose X_WS if any, the explorer if it
   /// drives) and renders the frames that fall due.
-  void Step(double t_s, const Pose2& X_WR_true, const SlamPair& slam, const LaserScan* scan,
+  void Step(double t_s, const Pose2& X_WR_true, const FilterBank& filters, const LaserScan* scan,
             const Pose2& X_WS, const explorer::Explorer* explorer);
 
   /// Closes the video; returns the number of frames.

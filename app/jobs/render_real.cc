@@ -30,7 +30,7 @@ const Rgb kCorner = {200, 0, 160};
 const Rgb kRobot = {220, 0, 0};
 
 // One trajectory of the run: which (0 odometry, 1 + f filter f in the order
-// of FilterNames()), its colours and map file.
+// of rundir::DefaultFilterNames()), its colours and map file.
 struct Track {
   int index;
   Rgb path;
@@ -66,10 +66,9 @@ RealRun ReadRealRun(const std::string& dir) {
   run.X_RS = *mount;
   const std::string trajectory_path = rundir::PathIn(dir, rundir::kTrajectoryFile);
   run.trajectory = rundir::ReadTrajectoryRows(trajectory_path);
-  if (run.trajectory.front().filters.size() != rundir::FilterNames().size()) {
-    throw std::runtime_error(trajectory_path + ": no filter columns (" +
-                             rundir::FilterNames().front() + "_x, ...)");
-  }
+  std::vector<std::string> names;
+  for (const rundir::FilterRow& f : run.trajectory.front().filters) names.push_back(f.name);
+  rundir::RequireDefaultFilters(names, trajectory_path, "the render of an imported log");
   run.scans_path = ImportedScansPath(dir);
   run.scans = rundir::ReadScanRows(run.scans_path);
   for (std::size_t i = 0; i < run.trajectory.size(); ++i) run.row_at[run.trajectory[i].t_s] = i;

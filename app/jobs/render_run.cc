@@ -123,17 +123,14 @@ class RunPlayback {
         trajectory_(rundir::ReadTrajectoryRows(trajectory_path_)),
         scans_(rundir::ReadScanRows((dir / rundir::kScansFile).string())),
         explorer_(ReadExplorer((dir / rundir::kExplorerFile).string())) {
-    frame_.filters = FilterLayers();
-    // The layers' filters among the trajectory's (in the order of FilterNames()).
-    const std::vector<std::string>& names = rundir::FilterNames();
-    if (trajectory_.front().filters.size() != names.size()) {
-      throw std::runtime_error(trajectory_path_ + ": no filter columns (" + names.front() + "_x, ...)");
+    // One layer per filter of the trajectory, in its order.
+    std::vector<std::string> names;
+    for (const rundir::FilterRow& f : trajectory_.front().filters) names.push_back(f.name);
+    if (names.empty()) {
+      throw std::runtime_error(trajectory_path_ + ": no filter columns (<name>_x, ...)");
     }
-    for (const renders::FilterLayer& layer : frame_.filters) {
-      const auto it = std::find(names.begin(), names.end(), layer.name);
-      if (it == names.end()) throw std::logic_error("no filter named " + layer.name);
-      filter_of_layer_.push_back(static_cast<std::size_t>(it - names.begin()));
-    }
+    frame_.filters = FilterLayers(names);
+    for (std::size_t i = 0; i < names.size(); ++i) filter_of_layer_.push_back(i);
   }
 
   /// Time of the last row, seconds.
@@ -150,7 +147,7 @@ class RunPlayback {
     if (snapshot != explorer_.begin()) frame_.explorer = (snapshot - 1)->layer;
   }
 
-  /// Puts both filters' final maps (map_*.csv) into the frame.
+  /// Puts every filter's final map (map_*.csv) into the frame.
   void ShowFinalMaps() {
     for (renders::FilterLayer& layer : frame_.filters) {
       ReadMap((dir_ / rundir::MapFile(layer.name)).string(), &layer);
@@ -198,7 +195,7 @@ class RunPlayback {
   std::vector<rundir::ScanRow> scans_;
   std::vector<ExplorerSnapshot> explorer_;
   renders::SceneFrame frame_;
-  // The filter (in the order of FilterNames()) of each of frame_.filters.
+  // The filter (in the trajectory's order) of each of frame_.filters.
   std::vector<std::size_t> filter_of_layer_;
   std::size_t next_row_ = 0;
 };

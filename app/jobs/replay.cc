@@ -4,7 +4,7 @@
 
 #include "app/engine/closed_loop.h"
 #include "app/jobs/progress.h"
-#include "app/engine/slam_pair.h"
+#include "app/engine/filter_bank.h"
 #include "app/jobs/version.h"
 #include "common/interrupt.h"
 #include "config/config.h"
@@ -43,7 +43,7 @@ bool ReplayRecording(const RunConfig& config, const rundir::Recording& recording
     // The same loop as a run, its records read from the recording.
     ClosedLoop loop(config, recording);
     rundir::CsvWriter trajectory(rundir::PathIn(dir, rundir::kTrajectoryFile),
-                                 rundir::TrajectoryColumns());
+                                 rundir::TrajectoryColumns(loop.filters().names()));
     Progress progress("replay", static_cast<double>(loop.num_steps()));
     while (!loop.Done()) {
       if (InterruptRequested()) {
@@ -56,7 +56,7 @@ bool ReplayRecording(const RunConfig& config, const rundir::Recording& recording
     }
     progress.Finish();
     trajectory.Flush();
-    WriteMaps(loop.slam(), dir);
+    WriteMaps(loop.filters(), dir);
   } catch (const std::exception& error) {
     manifest->Fail(error.what());
     throw;

@@ -9,7 +9,7 @@
 #include "app/engine/closed_loop.h"
 #include "app/jobs/live_video.h"
 #include "app/jobs/progress.h"
-#include "app/engine/slam_pair.h"
+#include "app/engine/filter_bank.h"
 #include "app/jobs/version.h"
 #include "common/interrupt.h"
 #include "common/params.h"
@@ -48,8 +48,10 @@ nlohmann::json StartManifest(const RunConfig& config, const RunOptions& options)
 // trajectory.csv, scans.csv and (when the explorer drives) explorer.csv.
 class StepFiles {
  public:
-  StepFiles(const std::string& dir, const RunConfig& config)
-      : trajectory_(rundir::PathIn(dir, rundir::kTrajectoryFile), rundir::TrajectoryColumns()),
+  StepFiles(const std::string& dir, const RunConfig& config,
+            const std::vector<std::string>& filter_names)
+      : trajectory_(rundir::PathIn(dir, rundir::kTrajectoryFile),
+                    rundir::TrajectoryColumns(filter_names)),
         scans_(rundir::PathIn(dir, rundir::kScansFile), rundir::ScanColumns(config.laser.num_beams)) {
     if (config.control.driver == "explorer") {
       explorer_.emplace(rundir::PathIn(dir, rundir::kExplorerFile), rundir::ExplorerColumns());
@@ -121,7 +123,7 @@ RunResult RunSimulation(const RunConfig& config, const RunOptions& options) {
     manifest.SetLaserMount(loop.X_RS());
     std::optional<LiveVideo> video;
     if (options.render_video) video.emplace(config, dir);
-    StepFiles files(dir, config);
+    StepFiles files(dir, config, loop.filters().names());
     Progress progress("run", loop.num_steps() - 1);
     while (!loop.Done()) {
       if (StopRequested(options)) {
@@ -138,7 +140,7 @@ RunResult RunSimulation(const RunConfig& config, const RunOptions& options) {
       progress.Update(step.index);
       if (video) {
         const ScopedCpuTimer timer(&result.cpu.video_s);
-        video->Step(step.record.t_s, step.row.X_WR_true, loop.slam(),
+        video->Step(step.record.t_s, step.row.X_WR_true, loop.filters(),
                     step.record.has_scan ? &step.record.scan : nullptr, step.X_WS_true, loop.explorer());
       }
     }
@@ -149,7 +151,7 @@ RunResult RunSimulation(const RunConfig& config, const RunOptions& options) {
       result.video_fps = result.video_frames / std::max(video->wall_s(), 1e-9);
     }
     files.Flush();
-    WriteMaps(loop.slam(), dir);
+    WriteMaps(loop.filters(), dir);
     // A fresh summary for this run (one from a run before is replaced);
     // evaluation merges its own keys into it.
     const rundir::RunSummary summary = loop.Summary(result.status == "interrupted");

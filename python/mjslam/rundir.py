@@ -62,7 +62,8 @@ REFERENCE_FILE = "reference.csv"
 SWEEP_RUNS_FOLDER = "runs"
 NEES_FILE = "nees.csv"
 
-# The two filters, classical then selective, as in file names and column prefixes.
+# The default filters (slam.filters absent), classical then selective, as in file names and
+# column prefixes; a run's own are Run.filter_names (its trajectory.csv's header).
 FILTER_NAMES = ("classical", "selective")
 
 # trajectory.csv: the recorded columns (what a replay reads), the explored fraction, then each
@@ -394,9 +395,10 @@ def read_divergence(path):
 
 
 def read_nees(path):
-    """nees.csv of a sweep: t, <filter>_anees, lower, upper, n_runs."""
+    """nees.csv of a sweep: t, <filter>_anees of each filter, lower, upper, n_runs."""
     table = read_csv(path)
-    check_columns(table, NEES_COLUMNS)
+    names = [c[:-len("_anees")] for c in table.columns if c.endswith("_anees")]
+    check_columns(table, ("t",) + tuple(n + "_anees" for n in names) + NEES_COLUMNS[-3:])
     return table
 
 

@@ -148,7 +148,7 @@ TEST(RealtimeRunTest, ReplayReproducesARealtimeRunBitForBit) {
   const CsvTable trajectory = ReadCsv(rundir::PathIn(run, rundir::kTrajectoryFile));
   ExpectSameTable(DropColumns(trajectory, "_us"),
                   DropColumns(ReadCsv(rundir::PathIn(dir, rundir::kTrajectoryFile)), "_us"));
-  for (const std::string& name : rundir::FilterNames()) {
+  for (const std::string& name : rundir::DefaultFilterNames()) {
     EXPECT_EQ(ReadText(rundir::PathIn(run, rundir::MapFile(name))),
               ReadText(rundir::PathIn(dir, rundir::MapFile(name))))
         << name;
@@ -156,7 +156,7 @@ TEST(RealtimeRunTest, ReplayReproducesARealtimeRunBitForBit) {
 
   const nlohmann::json summary =
       nlohmann::json::parse(ReadText(rundir::PathIn(run, rundir::kSummaryFile)));
-  for (const std::string& name : rundir::FilterNames()) {
+  for (const std::string& name : rundir::DefaultFilterNames()) {
     const int column = trajectory.ColumnIndex(name + "_processed");
     int processed = 0;
     for (const std::vector<double>& row : trajectory.rows) processed += row[column] == 1.0 ? 1 : 0;

@@ -3,6 +3,7 @@
 // and fail when either side changes alone.
 #include <fstream>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -91,7 +92,7 @@ TEST(LayoutTest, DocumentedTrajectoryColumnsAreTheWrittenOnes) {
   }
   EXPECT_EQ(suffixes, FilterColumnSuffixes());
   std::vector<std::string> expected = shared;
-  for (const std::string& name : FilterNames()) {
+  for (const std::string& name : DefaultFilterNames()) {
     for (const std::string& suffix : suffixes) expected.push_back(name + "_" + suffix);
   }
   EXPECT_EQ(expected, TrajectoryColumns());
@@ -126,8 +127,25 @@ TEST(LayoutTest, EveryFileIsDocumented) {
         kReferenceFile}) {
     EXPECT_NE(docs.find("`" + file + "`"), std::string::npos) << file;
   }
-  for (const std::string& name : FilterNames()) {
+  for (const std::string& name : DefaultFilterNames()) {
     EXPECT_NE(docs.find("`" + MapFile(name) + "`"), std::string::npos) << name;
+  }
+}
+
+TEST(LayoutTest, FilterNamesComeFromTheTrajectoryHeader) {
+  const std::vector<std::string> names = {"ekf_a", "dead_reckoning", "x"};
+  EXPECT_EQ(TrajectoryFilterNames(TrajectoryColumns(names)), names);
+  EXPECT_EQ(TrajectoryFilterNames(TrajectoryColumns()), DefaultFilterNames());
+  EXPECT_TRUE(TrajectoryFilterNames(RecordedTrajectoryColumns()).empty());
+  EXPECT_EQ(HeaderLine(NeesColumns({"a", "b", "c"})), "t,a_anees,b_anees,c_anees,lower,upper,n_runs\n");
+  EXPECT_NO_THROW(RequireDefaultFilters(DefaultFilterNames(), "f", "this"));
+  try {
+    RequireDefaultFilters({"classical", "other"}, "dir/trajectory.csv", "the render");
+    FAIL() << "no error";
+  } catch (const std::runtime_error& error) {
+    EXPECT_EQ(std::string(error.what()),
+              "dir/trajectory.csv: the render supports only the filters classical, selective "
+              "(got classical, other)");
   }
 }
 

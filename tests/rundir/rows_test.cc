@@ -183,6 +183,24 @@ TEST(RowsTest, TrajectoryRowsReadBackAsWritten) {
   }
 }
 
+// Any number of filters, named in the header: read back by name, in order.
+TEST(RowsTest, TrajectoryRowsOfNamedFiltersReadTheirNames) {
+  const std::string path = rundir::PathIn(FreshDir("named_filters"), rundir::kTrajectoryFile);
+  const std::vector<std::string> names = {"selective", "dead_reckoning", "ekf_max_3"};
+  TrajectoryRow row = DistinctRow(0.0, 0);
+  row.filters.push_back(row.filters[0]);
+  row.filters[2].X_WR = Pose2(7.0, 8.0, 0.5);
+  {
+    CsvWriter writer(path, TrajectoryColumns(names));
+    AddTrajectoryRow(row, &writer);
+  }
+  const std::vector<TrajectoryRow> read = ReadTrajectoryRows(path);
+  ASSERT_EQ(read.size(), 1u);
+  ASSERT_EQ(read[0].filters.size(), 3u);
+  for (std::size_t f = 0; f < names.size(); ++f) EXPECT_EQ(read[0].filters[f].name, names[f]);
+  EXPECT_EQ(read[0].filters[2].X_WR.x, 7.0);
+}
+
 TEST(RowsTest, TrajectoryRowsOfARecordingHaveNoFilters) {
   const std::string dir = FreshDir("trajectory_recorded");
   // Without truth and explored fraction, as mjslam import writes it.
@@ -248,7 +266,7 @@ TEST(RowsTest, TrajectoryRowsRefuseBadFieldsNamingFileLineAndColumn) {
   }
   // A column twice, one unknown, one missing.
   std::string twice = text;
-  twice.replace(twice.find("selective_x"), 11, "selective_y");
+  twice.replace(twice.find("selective_th"), 12, "selective_y");
   std::ofstream(dir + "/twice.csv") << twice;
   EXPECT_NE(ErrorOf([&] { ReadTrajectoryRows(dir + "/twice.csv"); }).find("column selective_y: twice"),
             std::string::npos);
@@ -278,7 +296,7 @@ TEST(RowsTest, TrajectoryRowsOfAnOlderRunReadTheColumnsByName) {
   const std::string dir = FreshDir("trajectory_older");
   const std::string header = "t,true_x,true_y,true_th,odom_x,odom_y,odom_th,cmd_v,cmd_w";
   std::string filters, values;
-  for (const std::string& name : FilterNames()) {
+  for (const std::string& name : DefaultFilterNames()) {
     // The pose last, after the counts.
     for (const char* suffix : {"pxx", "pxy", "pxth", "pyy", "pyth", "pthth", "nfeat", "nmatched",
                                "nupdated", "us", "x", "y", "th"}) {

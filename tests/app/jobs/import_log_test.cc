@@ -134,7 +134,7 @@ TEST(ImportLogTest, EveryBeamCountRunsBothFilters) {
     const double first_beam = written.laser.AngleMinRad() + manifest["laser_mount"]["th"].get<double>();
     EXPECT_NEAR(first_beam, shape.angle_min_deg * kPi / 180.0, 1e-9) << n;
     // Both filters saw the room's four walls from every scan: the map has them.
-    for (const std::string& name : rundir::FilterNames()) {
+    for (const std::string& name : rundir::DefaultFilterNames()) {
       int lines = 0;
       for (const MapFeature& f : rundir::ReadMapCsv(rundir::PathIn(dir, rundir::MapFile(name)))) {
         lines += f.type == FeatureType::kLine ? 1 : 0;
@@ -240,7 +240,7 @@ TEST(ImportLogTest, BreezySlamLogRunsBothFilters) {
   EXPECT_FALSE(report.has_reference);
   const nlohmann::json manifest = rundir::ReadManifest(dir);
   EXPECT_EQ(manifest["laser_offset_m"], 0.145);
-  for (const std::string& name : rundir::FilterNames()) {
+  for (const std::string& name : rundir::DefaultFilterNames()) {
     int lines = 0;
     for (const MapFeature& f : rundir::ReadMapCsv(rundir::PathIn(dir, rundir::MapFile(name)))) {
       lines += f.type == FeatureType::kLine ? 1 : 0;

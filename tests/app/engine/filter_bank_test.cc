@@ -1,16 +1,21 @@
-// SlamPair's realtime timing on synthetic records: a filter busy for k
+// FilterBank on synthetic records: any number of named filters of
+// registered kinds, each on its own timing; and the realtime timing: a filter busy for k
 // control steps skips exactly the scans of those steps, and its prediction
 // over the skipped steps integrates all of their motion.
 #include <cmath>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
 
 #include "app/engine/control.h"
-#include "app/engine/slam_pair.h"
+#include "app/engine/filter_bank.h"
+#include "app/engine/run_config.h"
+#include "config/config.h"
 #include "common/records.h"
 #include "eval/pose_metrics.h"
+#include "slam/filter.h"
 #include "slam/slam_params.h"
 
 namespace mjslam::app {
@@ -67,7 +72,7 @@ slam::SlamParams Timing(const std::string& timing, const std::string& input) {
   return params;
 }
 
-TEST(SlamPairTest, TimingTextBecomesTheEnum) {
+TEST(FilterBankTest, TimingTextBecomesTheEnum) {
   EXPECT_EQ(FilterTimingFromText("every_scan"), FilterTiming::kEveryScan);
   EXPECT_EQ(FilterTimingFromText("realtime"), FilterTiming::kRealtime);
   slam::SlamParams params;
@@ -80,10 +85,10 @@ TEST(SlamPairTest, TimingTextBecomesTheEnum) {
 
 // A period of k steps (cost 0.1 (k - 1) + 0.05 s): the filter processes
 // steps 0, k, 2k, ... and skips the scans of every step in between.
-TEST(SlamPairTest, RealtimeFilterBusyForKStepsSkipsExactlyThoseScans) {
+TEST(FilterBankTest, RealtimeFilterBusyForKStepsSkipsExactlyThoseScans) {
   const std::vector<SensorRecord> records = StraightRecords(std::vector<double>(20, 0.3));
   for (const int k : {1, 2, 3, 5}) {
-    SlamPair pair(Timing("realtime", "command"), ModelCost(kDt * (k - 1) + 0.05), kDt,
+    FilterBank pair(Timing("realtime", "command"), ModelCost(kDt * (k - 1) + 0.05), kDt,
                   Pose2(), Pose2(), Rng(1));
     int processed = 0;
     for (int s = 0; s < static_cast<int>(records.size()); ++s) {
@@ -103,9 +108,9 @@ TEST(SlamPairTest, RealtimeFilterBusyForKStepsSkipsExactlyThoseScans) {
 
 // The same records in every_scan timing: every scan processed, whatever the
 // period.
-TEST(SlamPairTest, EveryScanTimingProcessesEveryScan) {
+TEST(FilterBankTest, EveryScanTimingProcessesEveryScan) {
   const std::vector<SensorRecord> records = StraightRecords(std::vector<double>(10, 0.3));
-  SlamPair pair(Timing("every_scan", "command"), ModelCost(0.25), kDt, Pose2(), Pose2(), Rng(1));
+  FilterBank pair(Timing("every_scan", "command"), ModelCost(0.25), kDt, Pose2(), Pose2(), Rng(1));
   for (const SensorRecord& record : records) {
     pair.Step(record);
     EXPECT_TRUE(pair.processed(0));
@@ -117,9 +122,9 @@ TEST(SlamPairTest, EveryScanTimingProcessesEveryScan) {
 }
 
 // A skipped step's row holds the last processed estimate and says so.
-TEST(SlamPairTest, SkippedStepReportsTheLastProcessedEstimate) {
+TEST(FilterBankTest, SkippedStepReportsTheLastProcessedEstimate) {
   const std::vector<SensorRecord> records = StraightRecords(std::vector<double>(4, 0.5));
-  SlamPair pair(Timing("realtime", "command"), ModelCost(0.25), kDt, Pose2(), Pose2(), Rng(1));
+  FilterBank pair(Timing("realtime", "command"), ModelCost(0.25), kDt, Pose2(), Pose2(), Rng(1));
   pair.Step(records[0]);
   const std::vector<rundir::FilterRow> first = pair.Rows(Pose2());
   pair.Step(records[1]);
@@ -138,9 +143,9 @@ TEST(SlamPairTest, SkippedStepReportsTheLastProcessedEstimate) {
 // step) with the truth of that step, not with the truth of the step skipped:
 // the row repeats the processed row's NEES, which the current truth would
 // change.
-TEST(SlamPairTest, SkippedStepNeesIsThatOfTheStepItsEstimateIsOf) {
+TEST(FilterBankTest, SkippedStepNeesIsThatOfTheStepItsEstimateIsOf) {
   const std::vector<SensorRecord> records = StraightRecords(std::vector<double>(12, 0.5));
-  SlamPair pair(Timing("realtime", "command"), ModelCost(0.25), kDt, Pose2(), Pose2(), Rng(1));
+  FilterBank pair(Timing("realtime", "command"), ModelCost(0.25), kDt, Pose2(), Pose2(), Rng(1));
   std::vector<double> processed_nees(2, std::nan(""));
   int finite_skipped = 0;
   for (std::size_t k = 0; k < records.size(); ++k) {
@@ -166,11 +171,11 @@ TEST(SlamPairTest, SkippedStepNeesIsThatOfTheStepItsEstimateIsOf) {
 // 3 steps is, at its next processed step, where the commands of all 3 steps
 // take it (not 3 times the last one), exactly as a filter that ran every
 // step; in between it holds its last estimate.
-TEST(SlamPairTest, RealtimePredictionIntegratesEveryCommandOfTheSkippedSteps) {
+TEST(FilterBankTest, RealtimePredictionIntegratesEveryCommandOfTheSkippedSteps) {
   const std::vector<double> v = {0.0, 0.1, 0.2, 0.4, 0.3, 0.5, 0.1, 0.2, 0.3, 0.6, 0.2};
   const std::vector<SensorRecord> records = StraightRecords(v);
-  SlamPair realtime(Timing("realtime", "command"), ModelCost(0.25), kDt, Pose2(), Pose2(), Rng(1));
-  SlamPair every_scan(Timing("every_scan", "command"), ModelCost(0.25), kDt, Pose2(), Pose2(), Rng(1));
+  FilterBank realtime(Timing("realtime", "command"), ModelCost(0.25), kDt, Pose2(), Pose2(), Rng(1));
+  FilterBank every_scan(Timing("every_scan", "command"), ModelCost(0.25), kDt, Pose2(), Pose2(), Rng(1));
   double x = 0.0;
   double x_processed = 0.0;
   for (int s = 0; s < static_cast<int>(records.size()); ++s) {
@@ -197,10 +202,10 @@ TEST(SlamPairTest, RealtimePredictionIntegratesEveryCommandOfTheSkippedSteps) {
 
 // With odometry input the prediction of the next processed step takes the
 // odometry increment over all the skipped steps at once.
-TEST(SlamPairTest, RealtimePredictionTakesTheOdometryOfTheSkippedSteps) {
+TEST(FilterBankTest, RealtimePredictionTakesTheOdometryOfTheSkippedSteps) {
   const std::vector<double> v(13, 0.5);
   const std::vector<SensorRecord> records = StraightRecords(v);
-  SlamPair realtime(Timing("realtime", "odometry"), ModelCost(0.35), kDt, Pose2(), Pose2(), Rng(1));
+  FilterBank realtime(Timing("realtime", "odometry"), ModelCost(0.35), kDt, Pose2(), Pose2(), Rng(1));
   for (int s = 0; s < static_cast<int>(records.size()); ++s) {
     realtime.Step(records[s]);
     const double expected = s % 4 == 0 ? s * kDt * 0.5 : (s / 4) * 4 * kDt * 0.5;
@@ -217,7 +222,7 @@ TEST(SlamPairTest, RealtimePredictionTakesTheOdometryOfTheSkippedSteps) {
 // On an arc the skid term of the prediction depends on dt: the odometry
 // prediction over skipped steps must use the whole time since the last
 // processed record, as one filter given just those two records would.
-TEST(SlamPairTest, RealtimeOdometryPredictionUsesTheWholeElapsedTime) {
+TEST(FilterBankTest, RealtimeOdometryPredictionUsesTheWholeElapsedTime) {
   std::vector<SensorRecord> records = StraightRecords(std::vector<double>(5, 0.5));
   for (std::size_t k = 0; k < records.size(); ++k) {
     const double th = 0.5 * k * kDt;  // 0.5 rad/s on a 1 m radius
@@ -225,7 +230,7 @@ TEST(SlamPairTest, RealtimeOdometryPredictionUsesTheWholeElapsedTime) {
   }
   slam::SlamParams params = Timing("realtime", "odometry");
   ASSERT_GT(slam::LateralOf(params.ekf.process_model).skid_s, 0.0);
-  SlamPair realtime(params, ModelCost(0.35), kDt, Pose2(), Pose2(), Rng(1));
+  FilterBank realtime(params, ModelCost(0.35), kDt, Pose2(), Pose2(), Rng(1));
   for (const SensorRecord& record : records) realtime.Step(record);
   ASSERT_TRUE(realtime.processed(0));
 
@@ -243,6 +248,139 @@ TEST(SlamPairTest, RealtimeOdometryPredictionUsesTheWholeElapsedTime) {
   short_dt.Step(records[0], &none);
   short_dt.Step(records[4], &none);
   EXPECT_GT(std::abs(short_dt.X_WR().y - reference.X_WR().y), 1e-6);
+}
+
+slam::FilterParams Entry(const std::string& name, const std::string& update) {
+  slam::FilterParams entry;
+  entry.name = name;
+  entry.update = update;
+  return entry;
+}
+
+TEST(FilterBankTest, DefaultsAreThePapersTwoFilters) {
+  const FilterBank bank(slam::SlamParams{}, ModelCost(0.05), kDt, Pose2(), Pose2(), Rng(1));
+  ASSERT_EQ(bank.size(), 2);
+  EXPECT_EQ(bank.names(), (std::vector<std::string>{"classical", "selective"}));
+  EXPECT_EQ(bank.IndexOf("selective"), 1);
+  EXPECT_EQ(bank.IndexOf("odometry"), -1);
+}
+
+// Three named filters on the same records, one of them realtime: each runs
+// on its own timeline; the every_scan ones stay bit-identical to the
+// default bank's filters of the same update rule.
+TEST(FilterBankTest, NamedFiltersEachRunWithTheirOwnTiming) {
+  slam::SlamParams params;
+  params.filters = {Entry("a", "classical"), Entry("b", "selective"), Entry("c", "selective")};
+  params.filters[2].timing = "realtime";
+  params.filters[1].max_updates = 1;
+  ASSERT_TRUE(params.Validate().empty());
+  FilterBank bank(params, ModelCost(0.25), kDt, Pose2(), Pose2(), Rng(1));
+  FilterBank defaults(slam::SlamParams{}, ModelCost(0.25), kDt, Pose2(), Pose2(), Rng(1));
+  ASSERT_EQ(bank.names(), (std::vector<std::string>{"a", "b", "c"}));
+  const std::vector<SensorRecord> records = StraightRecords(std::vector<double>(9, 0.3));
+  for (int s = 0; s < static_cast<int>(records.size()); ++s) {
+    bank.Step(records[s]);
+    defaults.Step(records[s]);
+    EXPECT_TRUE(bank.processed(0));
+    EXPECT_TRUE(bank.processed(1));
+    EXPECT_EQ(bank.processed(2), s % 3 == 0) << "step " << s;
+    EXPECT_EQ(bank.Rows(Pose2()).size(), 3u);
+    EXPECT_EQ(bank.filter(0).X_WR().x, defaults.filter(0).X_WR().x);
+    EXPECT_EQ(bank.filter(0).pose_covariance(), defaults.filter(0).pose_covariance());
+  }
+  EXPECT_EQ(bank.timing(2), FilterTiming::kRealtime);
+  EXPECT_EQ(bank.scans_skipped(2), 6);
+  EXPECT_EQ(bank.scans_skipped(0), 0);
+}
+
+TEST(FilterBankTest, BadEntriesAreNamedByIndexAndKey) {
+  slam::SlamParams params;
+  params.filters = {Entry("a", "classical"), Entry("a", "sometimes"), Entry("Bad name", "selective"),
+                    Entry("odometry", "selective")};
+  params.filters[3].kind = "particle";
+  params.filters[0].selection_policy = "best";
+  std::vector<std::string> keys;
+  for (const ParamProblem& p : params.Validate()) keys.push_back(p.key);
+  EXPECT_EQ(keys, (std::vector<std::string>{"filters[0].selection_policy", "filters[1].update",
+                                            "filters[1].name", "filters[2].name",
+                                            "filters[3].name", "filters[3].kind"}));
+}
+
+// `slam.filters` in a config file: each problem names the file's line, the
+// key and the value; control.pose_source must name a filter; without the key
+// the resolved config has none (run directories as before).
+TEST(FilterBankTest, ConfigErrorsNameLineKeyAndValue) {
+  const std::string text =
+      "slam:\n"
+      "  filters:\n"
+      "    - {name: a, kind: ekf, update: classical}\n"
+      "    - {name: b, kind: ekf, update: sometimes}\n"
+      "    - {name: a, kind: particles}\n"
+      "control:\n"
+      "  pose_source: selective\n";
+  try {
+    config::LoadConfigString<RunConfig>(text, "x.yaml");
+    FAIL() << "no error";
+  } catch (const config::ConfigError& error) {
+    const std::string what = error.what();
+    EXPECT_NE(what.find("x.yaml:4:"), std::string::npos) << what;
+    EXPECT_NE(what.find("slam.filters[1].update: expected one of classical, selective (got sometimes)"),
+              std::string::npos) << what;
+    EXPECT_NE(what.find("x.yaml:5:"), std::string::npos) << what;
+    EXPECT_NE(what.find("slam.filters[2].kind"), std::string::npos) << what;
+    EXPECT_NE(what.find("slam.filters[2].name"), std::string::npos) << what;
+    EXPECT_NE(what.find("x.yaml:7:16: control.pose_source: expected one of a, b, a, odometry, "
+                        "ground_truth (got selective)"),
+              std::string::npos) << what;
+  }
+  const RunConfig defaults = config::LoadConfigString<RunConfig>("run: {seed: 2}\n", "y.yaml");
+  EXPECT_TRUE(defaults.slam.filters.empty());
+  EXPECT_EQ(config::ToYaml(defaults).find("filters"), std::string::npos);
+  const RunConfig named = config::LoadConfigString<RunConfig>(
+      "slam: {filters: [{name: mine, update: selective, max_updates: 3}]}\n"
+      "control: {pose_source: mine}\n",
+      "z.yaml");
+  ASSERT_EQ(named.slam.filters.size(), 1u);
+  EXPECT_EQ(named.slam.filters[0].max_updates, 3);
+  EXPECT_EQ(slam::SettingsOf(named.slam, named.slam.filters[0]).slam.ekf.max_updates, 3);
+  const RunConfig again = config::LoadConfigString<RunConfig>(config::ToYaml(named), "resolved");
+  EXPECT_EQ(again.slam.filters[0].name, "mine");
+}
+
+// A kind registered by a test: one class, one registration, no edit to the
+// bank. It reports the number of records it saw as its map size.
+class CountingFilter : public slam::Filter {
+ public:
+  slam::StepReport Step(const SensorRecord&, const slam::ScanFeatures*) override {
+    slam::StepReport report;
+    report.num_features = ++steps_;
+    return report;
+  }
+  Pose2 X_WR() const override { return Pose2(steps_, 0.0, 0.0); }
+  Eigen::Matrix3d pose_covariance() const override { return Eigen::Matrix3d::Identity(); }
+  std::vector<MapFeature> Map() const override { return {}; }
+  int num_features() const override { return steps_; }
+  bool predicts_from_odometry() const override { return true; }
+
+ private:
+  int steps_ = 0;
+};
+
+const slam::FilterRegistration kCounting(
+    "counting_test", [](const slam::FilterSettings&, const Pose2&, const Pose2&, Rng) {
+      return std::make_unique<CountingFilter>();
+    });
+
+TEST(FilterBankTest, ARegisteredKindRunsBesideThePapersFilters) {
+  slam::SlamParams params;
+  params.filters = {Entry("classical", "classical"), Entry("counter", "")};
+  params.filters[1].kind = "counting_test";
+  ASSERT_TRUE(params.Validate().empty());
+  FilterBank bank(params, ModelCost(0.05), kDt, Pose2(), Pose2(), Rng(1));
+  for (const SensorRecord& record : StraightRecords(std::vector<double>(4, 0.3))) bank.Step(record);
+  EXPECT_EQ(bank.filter(1).num_features(), 4);
+  EXPECT_EQ(bank.Rows(Pose2())[1].num_features, 4);
+  EXPECT_EQ(bank.filter(1).X_WR().x, 4.0);
 }
 
 }  // namespace

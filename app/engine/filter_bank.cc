@@ -1,4 +1,4 @@
-#include "app/engine/slam_pair.h"
+#include "app/engine/filter_bank.h"
 
 #include <chrono>
 #include <cmath>
@@ -27,35 +27,36 @@ FilterTiming FilterTimingFromText(const std::string& text) {
   return FilterTiming::kEveryScan;
 }
 
-SlamPair::SlamPair(const slam::SlamParams& params, const ControlParams& control, double dt_s,
-                   const Pose2& X_WR0, const Pose2& X_RS, const Rng& run_rng)
-    : params_(params),
-      control_(control),
-      dt_s_(dt_s),
-      timing_(FilterTimingFromText(params.timing)) {
+FilterBank::FilterBank(const slam::SlamParams& params, const ControlParams& control, double dt_s,
+                       const Pose2& X_WR0, const Pose2& X_RS, const Rng& run_rng)
+    : params_(params), control_(control), dt_s_(dt_s) {
   const slam::InnovationCheck check(params.innovation_check,
                                     slam::ChiSquare2Quantile(params.ekf.gate_probability));
-  filters_.emplace_back(
-      "classical",
-      slam::EkfSlam(params.ekf, slam::CorrectionMode::kClassical, X_WR0, X_RS,
-                    run_rng.Fork("slam.classical.selection")),
-      check);
-  // The selective filter's draws (slam.ekf.selection_policy: random) are a
-  // stream of their own, forked from the run seed by name.
-  filters_.emplace_back(
-      "selective",
-      slam::EkfSlam(params.ekf, slam::CorrectionMode::kSelective, X_WR0, X_RS,
-                    run_rng.Fork("slam.selective.selection")),
-      check);
+  // Each filter's draws (the selection policy random) are a stream of their
+  // own, forked from the run seed by the filter's name.
+  for (const slam::FilterParams& entry : slam::ResolvedFilters(params)) {
+    const slam::FilterSettings settings = slam::SettingsOf(params, entry);
+    filters_.emplace_back(entry.name,
+                          slam::FilterRegistry::Global().Make(settings, X_WR0, X_RS, run_rng),
+                          check, FilterTimingFromText(settings.slam.timing));
+    names_.push_back(entry.name);
+  }
 }
 
-void SlamPair::Step(const SensorRecord& record) {
+int FilterBank::IndexOf(const std::string& name) const {
+  for (int i = 0; i < size(); ++i) {
+    if (names_[i] == name) return i;
+  }
+  return -1;
+}
+
+void FilterBank::Step(const SensorRecord& record) {
   const int step = step_++;
   // Who processes this record: every filter, or in realtime timing those
   // whose last period has run out.
   bool any_processes = false;
-  for (Filter& f : filters_) {
-    f.processed = timing_ == FilterTiming::kEveryScan || step >= f.next_free_step;
+  for (Slot& f : filters_) {
+    f.processed = f.timing == FilterTiming::kEveryScan || step >= f.next_free_step;
     any_processes = any_processes || f.processed;
   }
   slam::ScanFeatures features;
@@ -65,12 +66,12 @@ void SlamPair::Step(const SensorRecord& record) {
     features = slam::ExtractFeatures(record.scan, params_.features);
     extraction_us = MicrosecondsSince(start);
   }
-  for (Filter& f : filters_) {
+  for (Slot& f : filters_) {
     if (f.processed) {
       const Clock::time_point start = Clock::now();
       const slam::ScanFeatures* given = record.has_scan ? &features : nullptr;
-      f.report = timing_ == FilterTiming::kEveryScan ? f.filter.Step(record, given)
-                                                     : CatchUpAndStep(&f, step, record, given);
+      f.report = f.timing == FilterTiming::kEveryScan ? f.filter->Step(record, given)
+                                                      : CatchUpAndStep(&f, step, record, given);
       f.processing_us = extraction_us + MicrosecondsSince(start);
       f.processing_s = ProcessingSeconds(control_, f.report, record.has_scan, f.processing_us);
       f.period_steps = CommandPeriodSteps(f.processing_s, dt_s_);
@@ -85,7 +86,7 @@ void SlamPair::Step(const SensorRecord& record) {
     } else {
       // Busy: the scan is lost; with command input the record's command
       // waits for the next prediction.
-      if (!slam::PredictsFromOdometry(params_.ekf.process_model)) {
+      if (!f.filter->predicts_from_odometry()) {
         SensorRecord motion;
         motion.t_s = record.t_s;
         motion.dt_s = record.dt_s;
@@ -110,30 +111,30 @@ void SlamPair::Step(const SensorRecord& record) {
   }
 }
 
-slam::StepReport SlamPair::CatchUpAndStep(Filter* f, int step, const SensorRecord& record,
+slam::StepReport FilterBank::CatchUpAndStep(Slot* f, int step, const SensorRecord& record,
                                           const slam::ScanFeatures* features) {
   // Command input: one prediction per skipped record, each with its own
   // command and dt, as if the filter had run them.
-  for (const SensorRecord& skipped : f->skipped_records) f->filter.Step(skipped, nullptr);
+  for (const SensorRecord& skipped : f->skipped_records) f->filter->Step(skipped, nullptr);
   f->skipped_records.clear();
   // (The first record, step 0, has no earlier one: it predicts nothing.)
-  if (!slam::PredictsFromOdometry(params_.ekf.process_model) || step == 0) {
-    return f->filter.Step(record, features);
+  if (!f->filter->predicts_from_odometry() || step == 0) {
+    return f->filter->Step(record, features);
   }
   // Odometry input: the filter takes the increment from the odometry pose of
   // its last processed record; dt is the whole time since that record.
   SensorRecord since_last = record;
   since_last.dt_s = record.t_s - f->last_processed_t_s;
-  return f->filter.Step(since_last, features);
+  return f->filter->Step(since_last, features);
 }
 
-std::vector<rundir::FilterRow> SlamPair::Rows(const Pose2& X_WR_true) {
+std::vector<rundir::FilterRow> FilterBank::Rows(const Pose2& X_WR_true) {
   std::vector<rundir::FilterRow> rows;
-  for (Filter& f : filters_) {
+  for (Slot& f : filters_) {
     if (f.processed) f.X_WR_true_processed = X_WR_true;
     rundir::FilterRow row;
-    row.X_WR = f.filter.X_WR();
-    row.P = f.filter.pose_covariance();
+    row.X_WR = f.filter->X_WR();
+    row.P = f.filter->pose_covariance();
     row.num_features = f.report.num_features;
     row.num_matched = f.report.num_matched;
     row.num_updated = f.report.num_updated;
@@ -148,10 +149,10 @@ std::vector<rundir::FilterRow> SlamPair::Rows(const Pose2& X_WR_true) {
   return rows;
 }
 
-void WriteMaps(const SlamPair& slam, const std::string& dir) {
-  for (int f = 0; f < 2; ++f) {
-    rundir::WriteMapCsv(rundir::PathIn(dir, rundir::MapFile(slam.name(f))),
-                        slam.filter(f).Map());
+void WriteMaps(const FilterBank& filters, const std::string& dir) {
+  for (int f = 0; f < filters.size(); ++f) {
+    rundir::WriteMapCsv(rundir::PathIn(dir, rundir::MapFile(filters.name(f))),
+                        filters.filter(f).Map());
   }
 }
 

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <memory>
 #include <string>
 #include <utility>
 #include <vector>
@@ -10,6 +11,7 @@
 #include "eval/map_types.h"
 #include "rundir/rows.h"
 #include "slam/ekf_slam.h"
+#include "slam/filter.h"
 #include "slam/innovation_check.h"
 #include "slam/slam_params.h"
 
@@ -31,35 +33,40 @@ enum class FilterTiming {
 /// SlamParams::Validate() has checked it. Aborts on any other text.
 FilterTiming FilterTimingFromText(const std::string& text);
 
-/// The two filters of the paper on the same records: the classical sequential
-/// EKF and the selective one. Features are extracted once per scan and given
-/// to both; each filter's processing time is that extraction plus its own
-/// step, measured with a steady clock. Each filter's processing time also
-/// gives the command period it would impose (ControlParams). With
-/// `slam.timing: realtime` each filter runs on its own timeline
+/// The run's filters on the same records (`slam.filters`, by default the
+/// paper's two: the classical sequential EKF and the selective one), each a
+/// slam::Filter of a registered kind, built by slam::FilterRegistry.
+/// Features are extracted once per scan and given to every filter; each
+/// filter's processing time is that extraction plus its own step, measured
+/// with a steady clock. Each filter's processing time also gives the command
+/// period it would impose (ControlParams). With `slam.timing: realtime` (or
+/// the filter's own `timing`) a filter runs on its own timeline
 /// (FilterTiming::kRealtime).
-class SlamPair {
+class FilterBank {
  public:
-  /// X_WR0: known initial pose of R; X_RS: the laser mount on R; `dt_s` the
-  /// control period without delay (one control step); `run_rng` the run
-  /// seed's stream, from which each filter forks its own draws by name (the
-  /// random selection policy).
-  SlamPair(const slam::SlamParams& params, const ControlParams& control, double dt_s,
-           const Pose2& X_WR0, const Pose2& X_RS, const Rng& run_rng);
+  /// The filters of slam::ResolvedFilters(params), in that order. X_WR0:
+  /// known initial pose of R; X_RS: the laser mount on R; `dt_s` the control
+  /// period without delay (one control step); `run_rng` the run seed's
+  /// stream, from which each filter forks its own draws by its name (the
+  /// random selection policy). Throws ParamError for a kind that is not
+  /// registered or invalid settings.
+  FilterBank(const slam::SlamParams& params, const ControlParams& control, double dt_s,
+             const Pose2& X_WR0, const Pose2& X_RS, const Rng& run_rng);
 
-  /// Runs both filters on one record, the record of the next control step
+  /// Runs every filter on one record, the record of the next control step
   /// (the first call is step 0). In realtime timing, a filter still busy
   /// with an earlier record skips this one (processed(i) is false after the
   /// call): its estimate and map stay those of its last processed record.
   /// A filter that is free predicts over every step since its last processed
-  /// record, then processes this one: with a process model of kind command,
-  /// one prediction per skipped record with that record's own command and dt;
-  /// of kind odometry, one prediction from the odometry pose of its
-  /// last processed record to this one's, dt the time between them.
+  /// record, then processes this one: with command input, one prediction per
+  /// skipped record with that record's own command and dt; with odometry
+  /// input (slam::Filter::predicts_from_odometry), one prediction from the
+  /// odometry pose of its last processed record to this one's, dt the time
+  /// between them.
   void Step(const SensorRecord& record);
 
-  /// Both filters' columns of trajectory.csv after the last step, in the
-  /// order of rundir::FilterNames(); X_WR_true is this step's true pose of R.
+  /// Every filter's columns of trajectory.csv after the last step, in the
+  /// order of names(); X_WR_true is this step's true pose of R.
   /// A filter that skipped the step reports its last processed estimate,
   /// covariance and map size, 0 matched, updated and microseconds, the period
   /// still running, and processed = false; its NEES compares that estimate
@@ -67,9 +74,14 @@ class SlamPair {
   /// not with this step's.
   std::vector<rundir::FilterRow> Rows(const Pose2& X_WR_true);
 
-  /// Processing time of filter `i` (0 classical, 1 selective) for the last
-  /// step, seconds (ControlParams::processing), and the command period it
-  /// imposes, in control steps.
+  /// Number of filters, their names in order, and the index of filter
+  /// `name` (-1: none).
+  int size() const { return static_cast<int>(filters_.size()); }
+  const std::vector<std::string>& names() const { return names_; }
+  int IndexOf(const std::string& name) const;
+  /// Processing time of filter `i` for the last step, seconds
+  /// (ControlParams::processing), and the command period it imposes, in
+  /// control steps.
   double processing_s(int i) const { return filters_[i].processing_s; }
   int period_steps(int i) const { return filters_[i].period_steps; }
   /// Totals so far of filter `i`: processing time, and open-loop time on its
@@ -89,22 +101,24 @@ class SlamPair {
   slam::InnovationCheckResult innovation_check(int i) const {
     return filters_[i].innovation_check.result();
   }
-  /// The timing the pair runs with.
-  FilterTiming timing() const { return timing_; }
+  /// The timing filter `i` runs with.
+  FilterTiming timing(int i) const { return filters_[i].timing; }
   /// Filter `i` by index, and its name.
-  const slam::EkfSlam& filter(int i) const { return filters_[i].filter; }
+  const slam::Filter& filter(int i) const { return *filters_[i].filter; }
   const std::string& name(int i) const { return filters_[i].name; }
 
-  const slam::EkfSlam& classical() const { return filters_[0].filter; }
-  const slam::EkfSlam& selective() const { return filters_[1].filter; }
-
  private:
-  struct Filter {
-    Filter(std::string name_in, slam::EkfSlam filter_in, slam::InnovationCheck check_in)
-        : name(std::move(name_in)), filter(std::move(filter_in)), innovation_check(check_in) {}
+  struct Slot {
+    Slot(std::string name_in, std::unique_ptr<slam::Filter> filter_in,
+         slam::InnovationCheck check_in, FilterTiming timing_in)
+        : name(std::move(name_in)),
+          filter(std::move(filter_in)),
+          innovation_check(check_in),
+          timing(timing_in) {}
     std::string name;
-    slam::EkfSlam filter;
+    std::unique_ptr<slam::Filter> filter;
     slam::InnovationCheck innovation_check;
+    FilterTiming timing;
     slam::StepReport report;
     double processing_us = 0.0;
     double processing_s = 0.0;
@@ -127,19 +141,19 @@ class SlamPair {
   // Realtime timing: filter `f` catches up over the records it skipped and
   // processes `record`, the record of control step `step` (the features
   // when it has a scan). Returns the filter's step report.
-  slam::StepReport CatchUpAndStep(Filter* f, int step, const SensorRecord& record,
+  slam::StepReport CatchUpAndStep(Slot* f, int step, const SensorRecord& record,
                                   const slam::ScanFeatures* features);
 
   slam::SlamParams params_;
   ControlParams control_;
   double dt_s_;
-  FilterTiming timing_;
   int step_ = 0;  // index of the next record
-  std::vector<Filter> filters_;
+  std::vector<Slot> filters_;
+  std::vector<std::string> names_;
 };
 
-/// Writes each filter's map (map_classical.csv, map_selective.csv) into the
-/// run directory `dir`.
-void WriteMaps(const SlamPair& slam, const std::string& dir);
+/// Writes each filter's map (map_<name>.csv: map_classical.csv,
+/// map_selective.csv by default) into the run directory `dir`.
+void WriteMaps(const FilterBank& filters, const std::string& dir);
 
 }  // namespace mjslam::app

@@ -1,0 +1,85 @@
+// Bring your own filter, end to end: examples/dead_reckoning.yaml runs the
+// example's filter beside the paper's two in one closed loop; the run
+// directory, its evaluation and a sweep go by the filters' names.
+#include <filesystem>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "rundir/layout.h"
+#include "rundir/rows.h"
+#include "rundir/run_files.h"
+#include "rundir/summary.h"
+#include "tests/integration/run_helpers.h"
+
+namespace mjslam::testing {
+namespace {
+
+std::string ExampleConfig() {
+  return std::string(MJSLAM_SOURCE_DIR) + "/examples/dead_reckoning.yaml";
+}
+
+TEST(OwnFilterTest, ExampleFilterRunsBesideThePapersTwo) {
+  const std::string dir = FreshDir("own_filter");
+  ASSERT_EQ(Shell(Program() + " run --quiet --no-render --config " + ExampleConfig() +
+                  " --duration 10 --seed 3 --out " + dir + " 2> " + dir + ".log"),
+            0)
+      << ReadText(dir + ".log");
+  // trajectory.csv: every filter's columns by name, in the config's order.
+  const std::vector<std::string> names = {"classical", "selective", "dead_reckoning"};
+  const rundir::CsvTable trajectory = rundir::ReadCsv(rundir::PathIn(dir, rundir::kTrajectoryFile));
+  EXPECT_EQ(trajectory.columns, rundir::TrajectoryColumns(names));
+  const std::vector<rundir::TrajectoryRow> rows =
+      rundir::ReadTrajectoryRows(rundir::PathIn(dir, rundir::kTrajectoryFile));
+  ASSERT_EQ(rows.back().filters.size(), 3u);
+  EXPECT_EQ(rows.back().filters[2].name, "dead_reckoning");
+  EXPECT_EQ(rows.back().filters[2].num_features, 0);
+  EXPECT_GT(rows.back().filters[2].P(0, 0), 0.0);
+  // A map per filter (the dead-reckoning one empty), a summary per filter.
+  for (const std::string& name : names) {
+    EXPECT_TRUE(std::filesystem::exists(rundir::PathIn(dir, rundir::MapFile(name)))) << name;
+  }
+  nlohmann::json summary = rundir::ReadSummary(dir);
+  EXPECT_EQ(summary["filters"].size(), 3u);
+  EXPECT_EQ(summary["filters"]["dead_reckoning"]["num_features"], 0);
+
+  // mjslam evaluate scores all three; the divergence compares the paper's two.
+  ASSERT_EQ(Shell(Program() + " evaluate " + dir + " --divergence-points 200 > " + dir +
+                  ".eval.log 2>&1"),
+            0)
+      << ReadText(dir + ".eval.log");
+  summary = rundir::ReadSummary(dir);
+  for (const std::string& name : names) {
+    EXPECT_TRUE(summary["filters"][name].contains("inside_2sigma")) << name;
+    EXPECT_TRUE(summary["filters"][name].contains("map")) << name;
+  }
+  EXPECT_TRUE(summary.contains("divergence"));
+  EXPECT_NE(ReadText(dir + ".eval.log").find("dead_reckoning"), std::string::npos);
+}
+
+// Without the paper's two filters a run is evaluated without the divergence;
+// the divergence command, which needs them, says which filters it got.
+TEST(OwnFilterTest, DivergenceWithoutThePapersPairNamesTheFilters) {
+  const std::string dir = FreshDir("own_filter_pair");
+  ASSERT_EQ(Shell(Program() + " run --quiet --no-render --config " + ExampleConfig() +
+                  " --duration 3 --seed 3 --out " + dir +
+                  " --set 'slam.filters=[{name: dr, kind: dead_reckoning}]' --set "
+                  "control.pose_source=dr 2> " + dir + ".log"),
+            0)
+      << ReadText(dir + ".log");
+  // The run's own evaluation leaves the divergence out, and says why.
+  EXPECT_FALSE(rundir::ReadSummary(dir).contains("divergence"));
+  EXPECT_NE(ReadText(dir + ".log").find("note: no divergence in summary.json"), std::string::npos)
+      << ReadText(dir + ".log");
+  EXPECT_TRUE(rundir::ReadSummary(dir)["filters"]["dr"].contains("mean_nees"));
+  EXPECT_NE(Shell(Program() + " divergence " + dir + " --points 100 --realisations 2 > " + dir +
+                  ".div.log 2>&1"),
+            0);
+  EXPECT_NE(ReadText(dir + ".div.log")
+                .find("the map divergence compares the filters classical and selective (got dr)"),
+            std::string::npos)
+      << ReadText(dir + ".div.log");
+}
+
+}  // namespace
+}  // namespace mjslam::testing
