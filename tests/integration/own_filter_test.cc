@@ -1,6 +1,6 @@
 // Bring your own filter, end to end: examples/dead_reckoning.yaml runs the
 // example's filter beside the paper's two in one closed loop; the run
-// directory, its evaluation and a sweep go by the filters' names.
+// directory, its evaluation, a sweep and a campaign go by the filters' names.
 #include <filesystem>
 
 #include <gtest/gtest.h>
@@ -79,6 +79,39 @@ TEST(OwnFilterTest, DivergenceWithoutThePapersPairNamesTheFilters) {
                 .find("the map divergence compares the filters classical and selective (got dr)"),
             std::string::npos)
       << ReadText(dir + ".div.log");
+}
+
+// A sweep and a campaign of named filters: nees.csv, summary.json and the
+// campaign table have a column or entry per filter of the runs, the
+// selection policies of examples/selection_policies.yaml paired on the same
+// records.
+TEST(OwnFilterTest, SweepAndCampaignGoByFilterName) {
+  const std::string root = FreshDir("own_filter_sweep");
+  const std::string config = std::string(MJSLAM_SOURCE_DIR) + "/examples/selection_policies.yaml";
+  const std::string common = " --config " + config + " --runs 2 --jobs 2 --duration 4 --quiet" +
+                             " --set control.driver=tour --set render.enabled=false";
+  ASSERT_EQ(Shell(Program() + " sweep" + common + " --out " + root + "/sweep > " + root +
+                  "/sweep.txt 2> " + root + "/sweep.log"),
+            0)
+      << ReadText(root + "/sweep.log");
+  const std::vector<std::string> names = {"classical", "criterion", "first", "random",
+                                          "least_informative", "determinant"};
+  const rundir::CsvTable nees = rundir::ReadCsv(root + "/sweep/nees.csv");
+  EXPECT_EQ(nees.columns, rundir::NeesColumns(names));
+  const nlohmann::json summary = rundir::ReadSummary(root + "/sweep");
+  for (const std::string& name : names) {
+    EXPECT_TRUE(summary["filters"][name].contains("verdict")) << name;
+    EXPECT_NE(ReadText(root + "/sweep.txt").find(name + " "), std::string::npos) << name;
+  }
+  // A campaign over MAX: its table has each filter's columns.
+  ASSERT_EQ(Shell(Program() + " sweep" + common + " --vary slam.ekf.max_updates=1,3 --out " +
+                  root + "/campaign > /dev/null 2> " + root + "/campaign.log"),
+            0)
+      << ReadText(root + "/campaign.log");
+  const std::string csv = ReadText(root + "/campaign/campaign.csv");
+  for (const std::string& name : names) {
+    EXPECT_NE(csv.find("," + name + "_verdict"), std::string::npos) << name << "\n" << csv;
+  }
 }
 
 }  // namespace
