@@ -2,16 +2,16 @@
 """The selective filter's choice of its MAX observations, by policy, on the same records.
 
     /usr/bin/python3 scripts/selection_ablation.py [--out runs/selection_ablation] [--runs 25]
-                                                   [--jobs 2] [--duration S]
+                                                   [--jobs 2] [--duration S] [--pose-source P]
 
 Runs, from the repository root, with build/mjslam (build it first), one `mjslam sweep` per
-model (configs/default.yaml, configs/paper.yaml) and per `slam.ekf.selection_policy`
-(criterion, first, random, least_informative, determinant), each over the same seeds in
-worlds/corridor_loop.xml with `control.pose_source: odometry`: the explorer drives from wheel
-odometry, which no policy changes, so every policy sees the same records (a paired ablation).
-The classical filter does not select; its row comes from the criterion sweep.
+model (configs/default.yaml, configs/paper.yaml) in worlds/corridor_loop.xml whose filters
+(`slam.filters`) are the classical EKF and the selective one once per `selection_policy`
+(criterion, first, random, least_informative, determinant): every filter of a run sees the
+same records (a paired ablation). The explorer drives from `--pose-source` (odometry by default,
+which no policy changes; or one policy's filter, closed loop on it, the others still paired).
 
-Writes DIR/<model>-<policy>/ (the sweeps) and DIR/ablation.md (the table, also printed):
+Writes DIR/<model>/ (the sweeps) and DIR/ablation.md (the table, also printed):
 per model and policy, the selective filter's mean ANEES, the fraction of steps with the ANEES
 inside its 95 % bounds, the fractions inside 2 sigma per component, the pose RMSE and the map's
 line rho / corner RMSE (means over the runs). A sweep whose summary.json exists is not rerun.
@@ -33,14 +33,20 @@ MODELS = ("default", "paper")
 POLICIES = ("criterion", "first", "random", "least_informative", "determinant")
 
 
-def run_sweep(program, model, policy, args, out):
+# The filters of each run: the classical EKF, and the selective one named by its policy.
+FILTERS = ("[{name: classical, update: classical}, " +
+           ", ".join("{name: %s, update: selective, selection_policy: %s}" % (p, p) for p in POLICIES) +
+           "]")
+
+
+def run_sweep(program, model, args, out):
     """Runs one sweep into `out` unless its summary.json exists; returns the summary."""
     sweep = mjslam.read_sweep(out)
     if not sweep.has(mjslam.SUMMARY_FILE):
         command = [program, "sweep", "--config", "configs/%s.yaml" % model, "--runs", str(args.runs),
                    "--jobs", str(args.jobs), "--out", out, "--quiet",
-                   "--set", "control.pose_source=odometry",
-                   "--set", "slam.ekf.selection_policy=%s" % policy]
+                   "--set", "slam.filters=" + FILTERS,
+                   "--set", "control.pose_source=%s" % args.pose_source]
         if args.duration is not None:
             command += ["--duration", str(args.duration)]
         print(" ".join(command), flush=True)
@@ -69,6 +75,8 @@ def main():
     parser.add_argument("--duration", type=float, default=None,
                         help="simulated seconds per run (default: the config's)")
     parser.add_argument("--mjslam", default="build/mjslam", help="the program [build/mjslam]")
+    parser.add_argument("--pose-source", default="odometry", choices=("odometry",) + POLICIES,
+                        help="what the explorer drives from [odometry]")
     args = parser.parse_args()
     os.makedirs(args.out, exist_ok=True)
 
@@ -77,15 +85,14 @@ def main():
              "|---|---|---|---|---|---|---|---|---|"]
     bounds = None
     for model in MODELS:
+        summary = run_sweep(args.mjslam, model, args, os.path.join(args.out, model))
+        bounds = summary["sweep"]["completed_runs"]
+        lines.append(row(model, "classical", summary["filters"]["classical"]))
         for policy in POLICIES:
-            summary = run_sweep(args.mjslam, model, policy, args,
-                                os.path.join(args.out, "%s-%s" % (model, policy)))
-            bounds = summary["sweep"]["completed_runs"]
-            if policy == "criterion":
-                lines.append(row(model, "classical", summary["filters"]["classical"]))
-            lines.append(row(model, "selective / " + policy, summary["filters"]["selective"]))
-    text = ("Selection policies, %d runs per sweep, corridor loop, explorer on odometry "
-            "(scripts/selection_ablation.py)\n\n" % bounds) + "\n".join(lines) + "\n"
+            lines.append(row(model, "selective / " + policy, summary["filters"][policy]))
+    text = ("Selection policies, %d runs per sweep, every policy a filter of the same runs, "
+            "corridor loop, explorer on %s (scripts/selection_ablation.py)\n\n"
+            % (bounds, args.pose_source)) + "\n".join(lines) + "\n"
     with open(os.path.join(args.out, "ablation.md"), "w") as f:
         f.write(text)
     sys.stdout.write(text)
