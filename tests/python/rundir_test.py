@@ -3,7 +3,7 @@
 Makes, with build/mjslam: a 4 s run of configs/default.yaml (evaluated: ground_truth_map.csv and
 the metrics in summary.json), an 8 s run of configs/paper.yaml (realtime: skipped steps), a sweep
 of two 2 s runs (nees.csv), a divergence study (divergence.csv) and an import of the Intel log
-(reference.csv). Then checks that the module's column lists are exactly the headers the program
+(reference.csv), and a run and a sweep with named filters (slam.filters). Then checks that the module's column lists are exactly the headers the program
 wrote, for every CSV file in those directories; that the values read give mjslam evaluate's
 figures in summary.json (2 sigma, RMSE, mean NEES, final error, map sizes); and that bad files
 raise errors naming file, line, column and value. About 5 s.
@@ -261,6 +261,27 @@ def test_sweep(sweep):
     assert (nees["lower"] < nees["upper"]).all()
     assert sweep.summary["sweep"]["completed_runs"] == 2
     assert sweep.divergence is None
+
+
+def test_named_filters(out):
+    """examples/dead_reckoning.yaml (three filters) and a sweep of two of its filters by other
+    names: filter_names, maps, errors and nees.csv go by the run's filters' names."""
+    path = str(out / "named")
+    program("run", "--quiet", "--config", "examples/dead_reckoning.yaml", "--duration", "3",
+            "--set", "render.enabled=false", "--out", path)
+    run = mjslam.read_run(path)
+    assert run.filter_names == ("classical", "selective", "dead_reckoning")
+    assert set(run.maps) == set(run.filter_names) and len(run.maps["dead_reckoning"]) == 0
+    assert run.errors("dead_reckoning").shape == (len(run.trajectory), 3)
+    assert set(run.summary["filters"]) == set(run.filter_names)
+    sweep_path = str(out / "named_sweep")
+    program("sweep", "--quiet", "--config", "examples/dead_reckoning.yaml", "--runs", "2",
+            "--jobs", "2", "--duration", "2", "--set", "render.enabled=false",
+            "--set", "slam.filters=[{name: a, update: classical}, {name: dr, kind: dead_reckoning}]",
+            "--set", "control.pose_source=a", "--out", sweep_path)
+    sweep = mjslam.read_sweep(sweep_path)
+    assert sweep.nees.columns == ("t", "a_anees", "dr_anees", "lower", "upper", "n_runs")
+    assert sweep.runs[0].filter_names == ("a", "dr")
 
 
 def test_imported_log(imported):
