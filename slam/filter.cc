@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <set>
 #include <utility>
+#include <variant>
 
 #include "common/check.h"
 #include "slam/ekf_filter.h"
@@ -50,6 +51,7 @@ std::vector<ParamProblem> FilterParams::Validate() const {
                 Names(std::begin(kSelectionPolicyNames), std::end(kSelectionPolicyNames)));
   }
   if (!timing.empty()) check.OneOf("timing", timing, {"every_scan", "realtime"});
+  check.Positive("process_noise_scale", process_noise_scale);
   if (registry.Has(kind)) {
     for (const ParamProblem& p : registry.Validate(*this)) {
       check.Require(false, p.key, p.value, p.expected);
@@ -71,6 +73,25 @@ std::vector<ParamProblem> ValidateFilters(const std::vector<FilterParams>& filte
   return check.problems();
 }
 
+namespace {
+
+// Every standard deviation of a process model's noise times `k`.
+void ScaleNoise(double k, CommandNoiseParams* noise) {
+  for (double* std : {&noise->v_std_mps, &noise->v_fraction, &noise->w_std_radps,
+                      &noise->w_fraction, &noise->change_fraction}) {
+    *std *= k;
+  }
+}
+void ScaleNoise(double k, OdometryNoiseParams* noise) {
+  for (double* std : {&noise->distance_std_m, &noise->distance_std_m_per_sqrt_m,
+                      &noise->distance_std_m_per_sqrt_rad, &noise->heading_std_rad,
+                      &noise->heading_std_rad_per_sqrt_m, &noise->heading_std_rad_per_sqrt_rad}) {
+    *std *= k;
+  }
+}
+
+}  // namespace
+
 std::vector<FilterParams> ResolvedFilters(const SlamParams& slam) {
   if (!slam.filters.empty()) return slam.filters;
   FilterParams classical;
@@ -89,6 +110,10 @@ FilterSettings SettingsOf(const SlamParams& slam, const FilterParams& filter) {
     settings.slam.ekf.selection_policy = filter.selection_policy;
   }
   if (!filter.timing.empty()) settings.slam.timing = filter.timing;
+  if (filter.process_noise_scale != 1.0) {
+    std::visit([&](auto& model) { ScaleNoise(filter.process_noise_scale, &model.noise); },
+               settings.slam.ekf.process_model);
+  }
   return settings;
 }
 

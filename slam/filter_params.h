@@ -28,6 +28,9 @@ struct FilterParams {
   std::string selection_policy;
   /// "every_scan" or "realtime" (slam.timing's values); "": slam.timing.
   std::string timing;
+  /// Scales every standard deviation of slam.ekf.process_model.noise (of
+  /// either kind) for this filter (> 0; 1: slam.ekf's noise as it is).
+  double process_noise_scale = 1.0;
 
   template <typename Archive>
   void Serialize(Archive* a) {
@@ -37,6 +40,7 @@ struct FilterParams {
     a->Visit(MJSLAM_NVP(max_updates));
     a->Visit(MJSLAM_NVP(selection_policy));
     a->Visit(MJSLAM_NVP(timing));
+    a->Visit(MJSLAM_NVP(process_noise_scale));
   }
   /// The problems of this entry alone (keys relative to it): the name's
   /// form, a registered kind, kind ekf's update, the ranges.

@@ -343,6 +343,17 @@ TEST(FilterBankTest, ConfigErrorsNameLineKeyAndValue) {
   ASSERT_EQ(named.slam.filters.size(), 1u);
   EXPECT_EQ(named.slam.filters[0].max_updates, 3);
   EXPECT_EQ(slam::SettingsOf(named.slam, named.slam.filters[0]).slam.ekf.max_updates, 3);
+  // process_noise_scale: every std of the process model's noise, of its kind.
+  slam::FilterParams noisy = named.slam.filters[0];
+  noisy.process_noise_scale = 2.0;
+  const slam::SlamParams scaled = slam::SettingsOf(named.slam, noisy).slam;
+  const auto& base = std::get<slam::CommandProcessModel>(named.slam.ekf.process_model).noise;
+  const auto& twice = std::get<slam::CommandProcessModel>(scaled.ekf.process_model).noise;
+  EXPECT_EQ(twice.v_std_mps, 2.0 * base.v_std_mps);
+  EXPECT_EQ(twice.change_fraction, 2.0 * base.change_fraction);
+  noisy.process_noise_scale = 0.0;
+  ASSERT_EQ(noisy.Validate().size(), 1u);
+  EXPECT_EQ(noisy.Validate()[0].key, "process_noise_scale");
   const RunConfig again = config::LoadConfigString<RunConfig>(config::ToYaml(named), "resolved");
   EXPECT_EQ(again.slam.filters[0].name, "mine");
 }
