@@ -38,7 +38,7 @@ enum class SelectionPolicy {
 };
 
 /// Where the filter evaluates the Jacobians of the prediction and of the
-/// observations (`slam.ekf.jacobians`; docs/method.md, departure 20).
+/// observations (`slam.ekf.jacobians`; docs/method.md, "First-estimates Jacobians").
 enum class JacobianPoint {
   /// At the current estimate, as the standard EKF (the paper's).
   kCurrent,
@@ -337,7 +337,7 @@ struct EkfParams {
   /// The systematic errors estimated in the state (SelfCalibrationParams).
   SelfCalibrationParams self_calibration;
   /// Where the Jacobians are evaluated: "current" (the standard EKF, the
-  /// paper's) or "first_estimates" (FEJ-EKF, docs/method.md departure 20).
+  /// paper's) or "first_estimates" (FEJ-EKF, docs/method.md, "First-estimates Jacobians").
   /// Read as JacobianPoint.
   std::string jacobians = "current";
 

@@ -1,5 +1,5 @@
 // First-estimates Jacobians (slam.ekf.jacobians: first_estimates; docs/method.md,
-// departure 20).
+// "First-estimates Jacobians").
 //
 // The observability test: a robot whose initial pose is uncertain (0.3 m,
 // 0.1 rad) drives around the pillar of a synthetic room (tests/support/
