@@ -31,16 +31,32 @@ int CsvTable::ColumnIndex(const std::string& column) const {
   throw std::runtime_error(path + ": missing column '" + column + "'");
 }
 
+namespace {
+
+// Reads the header line of `in` (file `path`) into its columns.
+std::vector<std::string> ReadHeaderLine(std::istream& in, const std::string& path) {
+  std::string line;
+  if (!std::getline(in, line)) throw std::runtime_error(path + ": empty file, expected a header");
+  if (in.eof()) throw std::runtime_error(path + ":1: the header has no line end (the file was cut short)");
+  if (!line.empty() && line.back() == '\r') line.pop_back();  // CRLF line ends
+  return SplitFields(line);
+}
+
+}  // namespace
+
+std::vector<std::string> ReadCsvHeader(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(path + ": cannot read");
+  return ReadHeaderLine(in, path);
+}
+
 CsvTable ReadCsv(const std::string& path, const std::vector<std::string>& text_columns) {
   std::ifstream in(path);
   if (!in) throw std::runtime_error(path + ": cannot read");
   CsvTable table;
   table.path = path;
+  table.columns = ReadHeaderLine(in, path);
   std::string line;
-  if (!std::getline(in, line)) throw std::runtime_error(path + ": empty file, expected a header");
-  if (in.eof()) throw std::runtime_error(path + ":1: the header has no line end (the file was cut short)");
-  if (!line.empty() && line.back() == '\r') line.pop_back();  // CRLF line ends
-  table.columns = SplitFields(line);
   std::vector<bool> is_text(table.columns.size(), false);
   for (std::size_t i = 0; i < table.columns.size(); ++i) {
     for (const std::string& name : text_columns) is_text[i] = is_text[i] || name == table.columns[i];

@@ -29,6 +29,10 @@ struct CsvTable {
 /// short, maybe inside its last field).
 CsvTable ReadCsv(const std::string& path, const std::vector<std::string>& text_columns = {});
 
+/// The columns of a CSV file's header line alone, with ReadCsv's rules;
+/// throws as ReadCsv does for an unreadable file or a header cut short.
+std::vector<std::string> ReadCsvHeader(const std::string& path);
+
 /// Checks that the table's columns start with `expected`, in order. Throws
 /// std::runtime_error naming the file and the first column that differs.
 void CheckLeadingColumns(const CsvTable& table, const std::vector<std::string>& expected);

@@ -36,8 +36,7 @@ FilterBank::FilterBank(const slam::SlamParams& params, const ControlParams& cont
   // own, forked from the run seed by the filter's name.
   for (const slam::FilterParams& entry : slam::ResolvedFilters(params)) {
     const slam::FilterSettings settings = slam::SettingsOf(params, entry);
-    filters_.emplace_back(entry.name,
-                          slam::FilterRegistry::Global().Make(settings, X_WR0, X_RS, run_rng),
+    filters_.emplace_back(slam::FilterRegistry::Global().Make(settings, X_WR0, X_RS, run_rng),
                           check, FilterTimingFromText(settings.slam.timing));
     names_.push_back(entry.name);
   }

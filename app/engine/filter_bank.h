@@ -105,17 +105,13 @@ class FilterBank {
   FilterTiming timing(int i) const { return filters_[i].timing; }
   /// Filter `i` by index, and its name.
   const slam::Filter& filter(int i) const { return *filters_[i].filter; }
-  const std::string& name(int i) const { return filters_[i].name; }
+  const std::string& name(int i) const { return names_[i]; }
 
  private:
   struct Slot {
-    Slot(std::string name_in, std::unique_ptr<slam::Filter> filter_in,
-         slam::InnovationCheck check_in, FilterTiming timing_in)
-        : name(std::move(name_in)),
-          filter(std::move(filter_in)),
-          innovation_check(check_in),
-          timing(timing_in) {}
-    std::string name;
+    Slot(std::unique_ptr<slam::Filter> filter_in, slam::InnovationCheck check_in,
+         FilterTiming timing_in)
+        : filter(std::move(filter_in)), innovation_check(check_in), timing(timing_in) {}
     std::unique_ptr<slam::Filter> filter;
     slam::InnovationCheck innovation_check;
     FilterTiming timing;
@@ -149,7 +145,7 @@ class FilterBank {
   double dt_s_;
   int step_ = 0;  // index of the next record
   std::vector<Slot> filters_;
-  std::vector<std::string> names_;
+  std::vector<std::string> names_;  // filters_[i] is named names_[i]
 };
 
 /// Writes each filter's map (map_<name>.csv: map_classical.csv,

@@ -5,7 +5,6 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <stdexcept>
 #include <utility>
 
@@ -13,6 +12,7 @@
 #include "app/engine/run_config.h"
 #include "common/interrupt.h"
 #include "common/rng.h"
+#include "rundir/csv_reader.h"
 #include "rundir/csv_writer.h"
 #include "rundir/layout.h"
 #include "rundir/manifest.h"
@@ -35,19 +35,6 @@ nlohmann::json Xyz(const Eigen::Vector3d& v) {
 // NaN as JSON null (nlohmann writes NaN as null anyway; explicit for clarity).
 nlohmann::json Number(double value) {
   return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(nullptr);
-}
-
-// The columns of the header line of CSV file `path` (empty when it cannot
-// be read).
-std::vector<std::string> HeaderColumns(const std::string& path) {
-  std::ifstream in(path);
-  std::string line;
-  std::getline(in, line);
-  if (!line.empty() && line.back() == '\r') line.pop_back();
-  std::vector<std::string> columns;
-  std::stringstream fields(line);
-  for (std::string field; std::getline(fields, field, ',');) columns.push_back(field);
-  return columns;
 }
 
 // Why the map divergence cannot be computed for a run with filters `names`
@@ -269,7 +256,7 @@ std::vector<eval::DivergenceStatistics> WriteDivergenceStudy(
   const std::string trajectory_path = rundir::PathIn(run_dir, rundir::kTrajectoryFile);
   std::vector<std::string> names;
   if (std::filesystem::exists(trajectory_path)) {
-    names = rundir::TrajectoryFilterNames(HeaderColumns(trajectory_path));
+    names = rundir::TrajectoryFilterNames(rundir::ReadCsvHeader(trajectory_path));
   } else {
     names = rundir::DefaultFilterNames();  // maps alone: the default filters'
   }

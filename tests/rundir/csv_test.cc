@@ -86,6 +86,24 @@ TEST(CsvTest, ReadsWindowsLineEnds) {
   EXPECT_TRUE(std::isnan(table.rows[1][1]));
 }
 
+TEST(CsvTest, HeaderAloneIsTheTablesColumns) {
+  // The header without the rows (a bad row below does not matter), with
+  // ReadCsv's rules: CRLF, a trailing empty column; a header cut short or a
+  // missing file throws naming the file.
+  const std::string path = TempPath("header.csv");
+  std::ofstream(path) << "t,classical_x,\r\nnot a number\n";
+  EXPECT_EQ(ReadCsvHeader(path), (std::vector<std::string>{"t", "classical_x", ""}));
+  const std::string cut = TempPath("header_cut.csv");
+  std::ofstream(cut) << "t,classical_x";
+  EXPECT_THROW(ReadCsvHeader(cut), std::runtime_error);
+  try {
+    ReadCsvHeader(TempPath("no_such.csv"));
+    FAIL() << "no error";
+  } catch (const std::runtime_error& error) {
+    EXPECT_NE(std::string(error.what()).find("no_such.csv"), std::string::npos);
+  }
+}
+
 TEST(CsvTest, BadInputNamesFileLineAndColumn) {
   const std::string path = TempPath("bad.csv");
   std::ofstream(path) << "t,x\n0,1\n0.1,abc\n";
