@@ -21,6 +21,7 @@ packages=(
   python3-yaml         # PyYAML: run directories' config.yaml (python/mjslam, the scripts)
   python3-numpy        # numpy: the columns of run files in Python (python/mjslam, the scripts)
   python3-pytest       # pytest: the tests of the Python package (tests/python)
+  python3-dev pybind11-dev python3-pybind11  # pybind11: the module mjslam._mjslam (python/bindings.cc)
   chromium             # headless Chromium: the test that index.html loads
   slurm-wlm munge      # Slurm: the one-node cluster of the sweep's Slurm test (scripts/slurm_localhost.sh)
 )
