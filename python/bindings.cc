@@ -15,7 +15,6 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
-#include <chrono>
 #include <cmath>
 #include <map>
 #include <memory>
@@ -287,7 +286,7 @@ void RegisterFilter(const std::string& kind, py::object filter_class) {
 // step), its arrays made when asked for.
 struct Step {
   app::LoopStep step;
-  std::vector<std::string> filter_names;
+  std::shared_ptr<const std::vector<std::string>> filter_names;
 };
 
 py::dict RowDict(const Step& s) {
@@ -305,7 +304,7 @@ py::dict RowDict(const Step& s) {
   d["explored"] = row.explored;
   for (std::size_t i = 0; i < row.filters.size(); ++i) {
     const rundir::FilterRow& f = row.filters[i];
-    const std::string& p = s.filter_names[i];
+    const std::string& p = (*s.filter_names)[i];
     d[py::str(p + "_x")] = f.X_WR.x;
     d[py::str(p + "_y")] = f.X_WR.y;
     d[py::str(p + "_th")] = f.X_WR.theta;
@@ -333,27 +332,24 @@ class Loop {
       : config_(app::LoadRunConfig(config_path, overrides)) {
     config_.ValidateOrThrow();
     loop_ = std::make_unique<app::ClosedLoop>(config_);
+    names_ = std::make_shared<const std::vector<std::string>>(loop_->filters().names());
   }
 
   bool done() const { return loop_->Done(); }
 
   Step DoStep() {
     if (loop_->Done()) throw py::stop_iteration("the loop is done");
-    const auto start = std::chrono::steady_clock::now();
-    Step s{loop_->Step(), loop_->filters().names()};
-    step_s_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    Step s{loop_->Step(), names_};
     ++steps_;
     return s;
   }
 
   int Run() {
     const int before = steps_;
-    const auto start = std::chrono::steady_clock::now();
     while (!loop_->Done()) {
       loop_->Step();
       ++steps_;
     }
-    step_s_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return steps_ - before;
   }
 
@@ -370,13 +366,13 @@ class Loop {
   const app::ClosedLoop& loop() const { return *loop_; }
   const app::RunConfig& config() const { return config_; }
   int steps() const { return steps_; }
-  double step_s() const { return step_s_; }
 
  private:
   app::RunConfig config_;
   std::unique_ptr<app::ClosedLoop> loop_;
+  // The filters' names, shared by every Step.
+  std::shared_ptr<const std::vector<std::string>> names_;
   int steps_ = 0;
-  double step_s_ = 0.0;  // wall seconds inside ClosedLoop::Step
 };
 
 py::dict MapColumns(const std::vector<MapFeature>& map) {
@@ -575,8 +571,17 @@ PYBIND11_MODULE(_mjslam, m) {
       .def_property_readonly("num_steps", [](const Loop& l) { return l.loop().num_steps(); },
                              "The most steps the loop runs (run.duration_s).")
       .def_property_readonly("steps", &Loop::steps, "Steps run so far.")
-      .def_property_readonly("step_seconds", &Loop::step_s,
-                             "Wall seconds spent inside the C++ steps so far.")
+      .def_property_readonly("cpu", [](const Loop& l) {
+        const app::PhaseCpu& c = l.loop().cpu();
+        py::dict d;
+        d["physics"] = c.physics_s;
+        d["laser"] = c.laser_s;
+        d["odometry"] = c.odometry_s;
+        d["coverage"] = c.coverage_s;
+        d["filters"] = c.filters_s;
+        d["driver"] = c.explorer_s;
+        return d;
+      }, "CPU seconds spent so far inside the C++ steps, by phase (mjslam run --profile's).")
       .def_property_readonly("filter_names",
                              [](const Loop& l) { return l.loop().filters().names(); })
       .def_property_readonly("config", [](const Loop& l) { return AsPython(l.config()); })
