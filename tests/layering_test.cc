@@ -21,7 +21,8 @@ namespace fs = std::filesystem;
 // of its own (app/README.md), each a folder here.
 const std::set<std::string> kCodeFolders = {
     "common",  "config",  "sim",       "slam",     "explorer",  "eval",      "rundir",
-    "realdata", "renders", "app/engine", "app/jobs", "app/batch", "app/cli", "fuzz", "examples"};
+    "realdata", "renders", "app/engine", "app/jobs", "app/batch", "app/cli", "fuzz", "examples",
+    "python"};
 
 // The project folder of `path` (a header as included, or a file's path
 // relative to the root): "app/<job>" inside app/, else its first component;
@@ -85,6 +86,11 @@ Rule RuleFor(const std::string& folder) {
     return {{"common", "config", "rundir", "realdata", "sim", "app/engine", "app/jobs", "app/batch",
              "fuzz"},
             false, false, false, true};
+  }
+  // The Python extension: the closed loop and the jobs it runs, as the
+  // command line does, but not the command line or batch work.
+  if (folder == "python") {
+    return {With(kBelowApp, {"app/engine", "app/jobs", "python"}), false, false, false, true};
   }
   return {With(kBelowApp, {"app/engine", "app/jobs", "app/batch", "app/cli"}), false, false, false,
           true};  // app/cli
