@@ -137,6 +137,10 @@ class PythonFilter : public slam::Filter {
         const std::string key = py::str(key_object);
         if (key == "nis_sum") {
           report.nis_sum = value.cast<double>();
+        } else if (key == "nearest_nis") {
+          report.nearest_nis = value.cast<std::vector<double>>();
+        } else if (key == "association") {
+          ReadAssociation(value, &report.association);
         } else if (int* field = IntField(&report, key)) {
           *field = value.cast<int>();
         } else {
@@ -144,9 +148,10 @@ class PythonFilter : public slam::Filter {
                                    "' (known: num_features, num_observed, num_matched, "
                                    "num_redundant_corners, num_updated, num_new, "
                                    "num_corners_from_lines, num_ambiguous, num_unanchored, "
-                                   "nis_sum)");
+                                   "nis_sum, nearest_nis, association)");
         }
       }
+      CheckPerObservation(report);
       if (report.num_features >= 0) return report;
     }
     report.num_features = num_features();
@@ -222,6 +227,50 @@ class PythonFilter : public slam::Filter {
     if (key == "num_ambiguous") return &r->num_ambiguous;
     if (key == "num_unanchored") return &r->num_unanchored;
     return nullptr;
+  }
+
+  // {"feature": [int, ...], "outcome": ["matched" | "new" | "ambiguous" |
+  // "unanchored", ...]}, one entry per observation.
+  void ReadAssociation(const py::handle value, slam::Association* association) const {
+    const py::dict d = py::reinterpret_borrow<py::dict>(value);
+    if (!py::isinstance<py::dict>(value) || !d.contains("feature") || !d.contains("outcome")) {
+      throw std::runtime_error(where_ + ": step()'s association must be a dict with the lists "
+                               "'feature' and 'outcome'");
+    }
+    association->feature = d["feature"].cast<std::vector<int>>();
+    association->outcome.clear();
+    for (const py::handle o : d["outcome"]) {
+      const std::string text = py::str(o);
+      if (text == "matched") {
+        association->outcome.push_back(slam::AssociationOutcome::kMatched);
+      } else if (text == "new") {
+        association->outcome.push_back(slam::AssociationOutcome::kNew);
+      } else if (text == "ambiguous") {
+        association->outcome.push_back(slam::AssociationOutcome::kAmbiguous);
+      } else if (text == "unanchored") {
+        association->outcome.push_back(slam::AssociationOutcome::kUnanchored);
+      } else {
+        throw std::runtime_error(where_ + ": step()'s association has the outcome '" + text +
+                                 "' (known: matched, new, ambiguous, unanchored)");
+      }
+    }
+  }
+
+  // What the innovation check reads per observation: nearest_nis and both
+  // lists of association, each with one entry per observation, or none of
+  // them.
+  void CheckPerObservation(const slam::StepReport& r) const {
+    const bool any = !r.nearest_nis.empty() || !r.association.feature.empty() ||
+                     !r.association.outcome.empty();
+    const auto check = [&](std::size_t size, const char* what) {
+      if (any && size != static_cast<std::size_t>(r.num_observed)) {
+        throw std::runtime_error(where_ + ": step()'s " + what + " has " + std::to_string(size) +
+                                 " entries for num_observed " + std::to_string(r.num_observed));
+      }
+    };
+    check(r.nearest_nis.size(), "nearest_nis");
+    check(r.association.feature.size(), "association['feature']");
+    check(r.association.outcome.size(), "association['outcome']");
   }
 
   template <int N>
