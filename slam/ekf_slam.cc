@@ -313,6 +313,12 @@ MotionInput EkfSlam::CheckedMotionInput(const SensorRecord& record) const {
   input.axle_track_m = params_.axle_track_m;
   const double drift = params_.self_calibration.wheel_slip_drift_std_per_sqrt_m;
   input.wheel_slip_drift_per_m = drift * drift;
+  // The derivatives by the odometry's errors (q_d, q_th, k) are taken at the
+  // commanded increment, which carries none of the odometry's noise: taken at
+  // the odometry's own increment, its noise would bias the scales towards
+  // less motion (docs/method.md, "Self-calibration").
+  input.calibration_jacobian_increment =
+      Eigen::Vector2d(record.command.v_mps * record.dt_s, record.command.w_radps * record.dt_s);
   return input;
 }
 

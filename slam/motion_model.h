@@ -1,5 +1,7 @@
 #pragma once
 
+#include <optional>
+
 #include <Eigen/Core>
 
 #include "common/pose2.h"
@@ -34,6 +36,10 @@ struct MotionInput {
   /// The wheels' track, metres, for self-calibration's term k B^2 / 4 dth
   /// (EkfParams::axle_track_m); unused without it.
   double axle_track_m = 0.0;
+  /// With self-calibration: the increment the derivatives by (q_d, q_th, k)
+  /// are taken at, free of the odometry's noise (EkfSlam gives the held
+  /// command times dt); `increment` when not set.
+  std::optional<Eigen::Vector2d> calibration_jacobian_increment;
 };
 
 /// The paper's Eq. (6) for the point of control h (frame R, `a_m` ahead of

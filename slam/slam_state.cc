@@ -130,8 +130,9 @@ void SlamState::PredictCalibrated(const MotionInput& raw, double a_m) {
   Eigen::Matrix2d D;
   D << 1.0 + q_d, k * quarter_track2, k, 1.0 + q_th;
   input.covariance = D * raw.covariance * D.transpose();
+  const Eigen::Vector2d at = raw.calibration_jacobian_increment.value_or(raw.increment);
   Eigen::Matrix<double, 2, 3> C;
-  C << d, 0.0, quarter_track2 * dth, 0.0, dth, d;
+  C << at.x(), 0.0, quarter_track2 * at.y(), 0.0, at.y(), at.x();
 
   Eigen::Matrix<double, 3, 2> W;
   const Eigen::Matrix3d A = MovePose(input, a_m, &W);

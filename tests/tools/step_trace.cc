@@ -58,8 +58,18 @@ void Trace(const std::string& dir, const std::string& name, double t_from, doubl
                 WrapAngle(corrected.theta - truth.theta), std::sqrt(filter.pose_covariance()(2, 2)),
                 std::hypot(corrected.x - truth.x, corrected.y - truth.y), report.num_observed,
                 report.num_matched, report.num_new, report.num_ambiguous);
+    if (filter.slam_state().calibrated()) {
+      const Eigen::VectorXd c = filter.slam_state().calibration();
+      std::printf("    calibration q_d %+.4f q_th %+.4f k %+.4f b %+.4f s %+.5f\n", c(0), c(1),
+                  c(2), c(3), c(4));
+    }
     for (int o = 0; o < report.num_observed; ++o) {
       const slam::AssociationOutcome outcome = report.association.outcome[o];
+      if (o < static_cast<int>(features.lines.size())) {
+        const slam::LineObservation& l = features.lines[o];
+        std::printf("    (rho %.3f alpha %+.3f, beams %d-%d)", l.rho_m, l.alpha_rad, l.first_beam,
+                    l.last_beam);
+      }
       std::printf("    %s %d: %s, nearest NIS %.1f\n",
                   o < static_cast<int>(features.lines.size()) ? "line" : "corner", o,
                   outcome == slam::AssociationOutcome::kMatched ? "matched"
