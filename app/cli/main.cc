@@ -383,7 +383,7 @@ int EvaluateImportedMain(const std::string& run_dir) {
   for (std::size_t f = 0; f < result.num_features.size(); ++f) {
     std::printf("%s: %d features; pose covariance not positive semi-definite in %d rows, "
                 "singular in %d\n",
-                rundir::DefaultFilterNames()[f].c_str(), result.num_features[f],
+                result.filter_names[f].c_str(), result.num_features[f],
                 result.not_positive_semidefinite[f], result.singular[f]);
   }
   return 0;
