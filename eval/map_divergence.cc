@@ -307,21 +307,31 @@ double KlDivergence(const std::vector<double>& log_p, const std::vector<double>&
   return d;
 }
 
-MapDivergences ComputeMapDivergences(const GaussianMixture& classical,
-                                     const GaussianMixture& selective,
+std::vector<std::string> DivergenceLabels(const DivergencePair& pair) {
+  return {pair.first + "_" + pair.second, pair.second + "_" + pair.first, pair.first + "_truth",
+          pair.second + "_truth"};
+}
+
+bool HasDivergenceMass(const Map& map) {
+  return std::any_of(map.begin(), map.end(), [](const MapFeature& f) {
+    return f.type == MapFeature::Type::kCorner || f.has_segment;
+  });
+}
+
+MapDivergences ComputeMapDivergences(const GaussianMixture& first, const GaussianMixture& second,
                                      const GaussianMixture& truth, int num_points, Rng* rng,
                                      const DivergenceParams& params) {
   params.ValidateOrThrow();
-  const Box box = CommonBoundingBox({&classical, &selective, &truth}, params.margin_m);
+  const Box box = CommonBoundingBox({&first, &second, &truth}, params.margin_m);
   const std::vector<Eigen::Vector2d> points = UniformPoints(box, num_points, rng);
-  const std::vector<double> c = LogPmf(classical, points);
-  const std::vector<double> s = LogPmf(selective, points);
+  const std::vector<double> a = LogPmf(first, points);
+  const std::vector<double> b = LogPmf(second, points);
   const std::vector<double> t = LogPmf(truth, points);
-  return {KlDivergence(c, s), KlDivergence(s, c), KlDivergence(c, t), KlDivergence(s, t)};
+  return {KlDivergence(a, b), KlDivergence(b, a), KlDivergence(a, t), KlDivergence(b, t)};
 }
 
-std::vector<DivergenceStatistics> DivergenceStudy(const Map& classical, const Map& selective,
-                                                  const Map& truth,
+std::vector<DivergenceStatistics> DivergenceStudy(const Map& first, const Map& second,
+                                                  const Map& truth, const DivergencePair& pair,
                                                   const std::vector<int>& num_points,
                                                   int realisations, const Rng& rng,
                                                   const DivergenceParams& params) {
@@ -329,17 +339,18 @@ std::vector<DivergenceStatistics> DivergenceStudy(const Map& classical, const Ma
     throw std::invalid_argument("divergence: realisations must be >= 1 (got " +
                                 std::to_string(realisations) + ")");
   }
-  const GaussianMixture c = MapToMixture(classical, params);
-  const GaussianMixture s = MapToMixture(selective, params);
+  const GaussianMixture a = MapToMixture(first, params);
+  const GaussianMixture b = MapToMixture(second, params);
   const GaussianMixture t = MapToMixture(truth, params, MapRole::kTruth);
-  const std::pair<const GaussianMixture*, const char*> mixtures[3] = {
-      {&c, "classical"}, {&s, "selective"}, {&t, "truth"}};
+  const std::pair<const GaussianMixture*, std::string> mixtures[3] = {
+      {&a, pair.first}, {&b, pair.second}, {&t, "truth"}};
   for (const auto& [m, name] : mixtures) {
     if (m->means.empty()) {
-      throw std::invalid_argument(std::string("divergence: the ") + name +
+      throw std::invalid_argument("divergence: the " + name +
                                   " map has no corner and no line with a segment");
     }
   }
+  const std::vector<std::string> labels = DivergenceLabels(pair);
   std::vector<DivergenceStatistics> rows;
   for (const int e : num_points) {
     if (e < 1) {
@@ -350,14 +361,11 @@ std::vector<DivergenceStatistics> DivergenceStudy(const Map& classical, const Ma
     for (int k = 0; k < realisations; ++k) {
       ThrowIfInterrupted("map divergence");
       Rng stream = rng.Fork("divergence/" + std::to_string(e) + "/" + std::to_string(k));
-      samples.push_back(ComputeMapDivergences(c, s, t, e, &stream, params));
+      samples.push_back(ComputeMapDivergences(a, b, t, e, &stream, params));
     }
-    const char* names[4] = {"classical_selective", "selective_classical", "classical_truth",
-                            "selective_truth"};
     for (int p = 0; p < 4; ++p) {
       auto value = [p](const MapDivergences& d) {
-        const double v[4] = {d.classical_selective, d.selective_classical, d.classical_truth,
-                             d.selective_truth};
+        const double v[4] = {d.first_second, d.second_first, d.first_truth, d.second_truth};
         return v[p];
       };
       double mean = 0.0;
@@ -366,7 +374,7 @@ std::vector<DivergenceStatistics> DivergenceStudy(const Map& classical, const Ma
       double variance = 0.0;
       for (const MapDivergences& d : samples) variance += std::pow(value(d) - mean, 2);
       variance = realisations > 1 ? variance / (realisations - 1) : 0.0;
-      rows.push_back({e, names[p], mean, variance});
+      rows.push_back({e, labels[p], mean, variance});
     }
   }
   return rows;

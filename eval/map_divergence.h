@@ -92,19 +92,34 @@ std::vector<double> LogPmf(const GaussianMixture& mixture,
 /// of two pmfs given by their logs over the same points (sizes checked).
 double KlDivergence(const std::vector<double>& log_p, const std::vector<double>& log_q);
 
-/// The four divergences of one realisation, nats: between the two filters'
-/// maps in both orders and from each to the ground truth.
+/// The two maps a divergence study compares, by name (a run's filter names:
+/// "classical" and "selective" by default), which label its rows.
+struct DivergencePair {
+  std::string first = "classical";
+  std::string second = "selective";
+};
+
+/// The four labels of `pair`'s divergences, in the order of MapDivergences:
+/// "<first>_<second>", "<second>_<first>", "<first>_truth", "<second>_truth".
+std::vector<std::string> DivergenceLabels(const DivergencePair& pair);
+
+/// Whether MapToMixture gives `map` a Gaussian (a corner, or a line with a
+/// seen segment): whether it has something for the divergence to compare.
+bool HasDivergenceMass(const Map& map);
+
+/// The four divergences of one realisation, nats: between two maps (first
+/// and second, e.g. two filters') in both orders and from each to the ground
+/// truth.
 struct MapDivergences {
-  double classical_selective = 0.0;  // D(classical || selective)
-  double selective_classical = 0.0;  // D(selective || classical)
-  double classical_truth = 0.0;      // D(classical || truth)
-  double selective_truth = 0.0;      // D(selective || truth)
+  double first_second = 0.0;  // D(first || second)
+  double second_first = 0.0;  // D(second || first)
+  double first_truth = 0.0;   // D(first || truth)
+  double second_truth = 0.0;  // D(second || truth)
 };
 
 /// One realisation: `num_points` points uniform in the common bounding box of
 /// the three maps (grown by margin_m), drawn from `rng`.
-MapDivergences ComputeMapDivergences(const GaussianMixture& classical,
-                                     const GaussianMixture& selective,
+MapDivergences ComputeMapDivergences(const GaussianMixture& first, const GaussianMixture& second,
                                      const GaussianMixture& truth, int num_points, Rng* rng,
                                      const DivergenceParams& params = {});
 
@@ -112,23 +127,24 @@ MapDivergences ComputeMapDivergences(const GaussianMixture& classical,
 /// divergence at one number of points: a row of divergence.csv.
 struct DivergenceStatistics {
   int num_points = 0;
-  /// "classical_selective", "selective_classical", "classical_truth" or
-  /// "selective_truth".
+  /// One of DivergenceLabels(pair): "classical_selective", ... by default.
   std::string pair;
   double mean = 0.0;
   double variance = 0.0;
 };
 
-/// The paper's Figs. 6 and 7: for each entry of `num_points`,
-/// `realisations` independent realisations (realisation k at E points draws
-/// from rng.Fork("divergence/E/k"), so every number is reproducible on its
-/// own). Rows in the order of `num_points`, then of the pairs above.
-/// realisations >= 1 and every num_points >= 1, and each map has a corner or
-/// a line with a segment (else throws std::invalid_argument naming the map:
-/// classical, selective or truth). Throws Interrupted (common/interrupt.h)
-/// within a fraction of a second of a stop request.
-std::vector<DivergenceStatistics> DivergenceStudy(const Map& classical, const Map& selective,
-                                                  const Map& truth,
+/// The paper's Figs. 6 and 7 for the maps `first` and `second` (named by
+/// `pair`): for each entry of `num_points`, `realisations` independent
+/// realisations (realisation k at E points draws from
+/// rng.Fork("divergence/E/k"), whatever the pair, so every number is
+/// reproducible on its own). Rows in the order of `num_points`, then of
+/// DivergenceLabels(pair). realisations >= 1 and every num_points >= 1, and
+/// each map has a corner or a line with a segment (else throws
+/// std::invalid_argument naming the map: pair.first, pair.second or truth).
+/// Throws Interrupted (common/interrupt.h) within a fraction of a second of a
+/// stop request.
+std::vector<DivergenceStatistics> DivergenceStudy(const Map& first, const Map& second,
+                                                  const Map& truth, const DivergencePair& pair,
                                                   const std::vector<int>& num_points,
                                                   int realisations, const Rng& rng,
                                                   const DivergenceParams& params = {});

@@ -32,7 +32,7 @@ import matplotlib.ticker  # noqa: E402
 # The renders' colours (renders/scene_renderer.h, namespace colors).
 COLORS = {"truth": "#0d0d0d", "classical": "#ff8000", "selective": "#0066ff"}
 FILTERS = mjslam.FILTER_NAMES  # the default filters (the paper's scripts use them)
-# Any other filter's colour, in turn (app/jobs/scene_frame.cc, FilterLayers).
+# Any other filter's colour, in turn (renders/filter_colors.cc, FilterColors).
 OTHER_COLORS = ("#009999", "#8c4d1a", "#808c00", "#f266a6", "#808080")
 
 
@@ -203,11 +203,18 @@ def plot_divergence(div, path):
     scripts/paper_experiments.py draws them apart)."""
     fig, axes = plt.subplots(1, 2, figsize=(10, 4))
     pairs = sorted(set(div["pair"]))
+    try:
+        first, second = mjslam.divergence_pair(div)
+        names = {f"{first}_{second}": f"{first} vs {second}",
+                 f"{second}_{first}": f"{second} vs {first}",
+                 f"{first}_truth": f"{first} vs truth", f"{second}_truth": f"{second} vs truth"}
+    except mjslam.RunFormatError:  # not every row there: labels split at each '_'
+        names = {}
     for ax, key in zip(axes, ("mean", "variance")):
         for pair in pairs:
             rows = sorted((n, v) for n, v, p in zip(div["num_points"], div[key], div["pair"]) if p == pair)
             ax.plot([r[0] for r in rows], [r[1] for r in rows], marker="o", ms=3, lw=1.2,
-                    label=pair.replace("_", " vs "))
+                    label=names.get(pair, pair.replace("_", " vs ")))
         ax.set_xscale("log")
         ax.set_xlabel("#E (Monte Carlo points)")
         ax.set_ylabel(f"divergence {key} (nats)" if key == "mean" else "divergence variance (nats²)")

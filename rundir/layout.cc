@@ -1,24 +1,10 @@
 #include "rundir/layout.h"
 
-#include <stdexcept>
-
 namespace mjslam::rundir {
 
 const std::vector<std::string>& DefaultFilterNames() {
   static const std::vector<std::string> kNames = {"classical", "selective"};
   return kNames;
-}
-
-void RequireDefaultFilters(const std::vector<std::string>& names, const std::string& where,
-                           const std::string& what) {
-  if (names == DefaultFilterNames()) return;
-  auto joined = [](const std::vector<std::string>& list) {
-    std::string text;
-    for (const std::string& name : list) text += (text.empty() ? "" : ", ") + name;
-    return text.empty() ? std::string("none") : text;
-  };
-  throw std::runtime_error(where + ": " + what + " supports only the filters " +
-                           joined(DefaultFilterNames()) + " (got " + joined(names) + ")");
 }
 
 std::string MapFile(const std::string& filter_name) { return "map_" + filter_name + ".csv"; }

@@ -38,12 +38,6 @@ const std::vector<std::string>& DefaultFilterNames();
 /// `<name>_x` other than true_x and odom_x, in order (empty: a recording).
 std::vector<std::string> TrajectoryFilterNames(const std::vector<std::string>& columns);
 
-/// For a consumer that supports only the default filters: throws
-/// std::runtime_error "<where>: <what> supports only the filters classical,
-/// selective (got <names>)" unless `names` are DefaultFilterNames().
-void RequireDefaultFilters(const std::vector<std::string>& names, const std::string& where,
-                           const std::string& what);
-
 /// The map file of filter `name`: "map_<name>.csv".
 std::string MapFile(const std::string& filter_name);
 

@@ -7,6 +7,7 @@
 #include <deque>
 #include <filesystem>
 #include <limits>
+#include <set>
 #include <stdexcept>
 #include <thread>
 
@@ -619,12 +620,19 @@ nlohmann::json AggregateSweep(const std::vector<std::string>& run_dirs, const st
   for (std::size_t f = 0; f < runs.names.size(); ++f) {
     summary["filters"][runs.names[f]] = FilterAggregate(f, runs, counts, options);
   }
-  // The mean of the runs' divergences, when they were evaluated with one.
-  for (const char* pair : {"classical_selective", "selective_classical", "classical_truth",
-                           "selective_truth"}) {
+  // The mean of the runs' divergences, when they were evaluated with one:
+  // each of their pairs' labels (eval::DivergenceLabels), by name.
+  std::set<std::string> labels;
+  for (const nlohmann::json& s : runs.summaries) {
+    if (!s.contains("divergence") || !s["divergence"].is_object()) continue;
+    for (const auto& [key, value] : s["divergence"].items()) {
+      if (key != "num_points" && key != "realisations") labels.insert(key);
+    }
+  }
+  for (const std::string& label : labels) {
     const nlohmann::json value =
-        MeanOf(runs.summaries, nlohmann::json::json_pointer(std::string("/divergence/") + pair));
-    if (!value.is_null()) summary["divergence"]["runs_mean"][pair] = value;
+        MeanOf(runs.summaries, nlohmann::json::json_pointer("/divergence/" + label));
+    if (!value.is_null()) summary["divergence"]["runs_mean"][label] = value;
   }
   return summary;
 }

@@ -350,6 +350,10 @@ CLI::App* AddEvaluate(CLI::App* cli, EvaluateCommand* c) {
                        "Realisations of the divergence (their mean is reported)")
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
+  evaluate->add_option("--pair", c->options.divergence_pair,
+                       "The two filters the divergence compares [classical selective, else the "
+                       "first two with a map]")
+      ->expected(2);
   evaluate->add_flag("--profile", c->profile, "Print the CPU seconds of each stage");
   return evaluate;
 }
@@ -383,7 +387,7 @@ int EvaluateImportedMain(const std::string& run_dir) {
   for (std::size_t f = 0; f < result.num_features.size(); ++f) {
     std::printf("%s: %d features; pose covariance not positive semi-definite in %d rows, "
                 "singular in %d\n",
-                rundir::DefaultFilterNames()[f].c_str(), result.num_features[f],
+                result.filter_names[f].c_str(), result.num_features[f],
                 result.not_positive_semidefinite[f], result.singular[f]);
   }
   return 0;
@@ -411,10 +415,11 @@ int EvaluateMain(const EvaluateCommand& c) {
     std::printf("no divergence: %s\n", result.no_divergence.c_str());
   }
   if (result.has_divergence) {
-    std::printf("divergence: classical||selective %.4g, selective||classical %.4g, "
-                "classical||truth %.4g, selective||truth %.4g\n",
-                result.divergence.classical_selective, result.divergence.selective_classical,
-                result.divergence.classical_truth, result.divergence.selective_truth);
+    const char* a = result.divergence_pair.first.c_str();
+    const char* b = result.divergence_pair.second.c_str();
+    std::printf("divergence: %s||%s %.4g, %s||%s %.4g, %s||truth %.4g, %s||truth %.4g\n", a, b,
+                result.divergence.first_second, b, a, result.divergence.second_first, a,
+                result.divergence.first_truth, b, result.divergence.second_truth);
   }
   if (c.profile) {
     const EvaluationCpu& cpu = result.cpu;
@@ -607,6 +612,7 @@ struct DivergenceCommand {
   std::vector<int> num_points = {100, 200, 500, 1000, 2000, 5000, 10000, 20000};
   int realisations = 100;
   std::string out;
+  std::vector<std::string> pair;
   eval::DivergenceParams params;
 };
 
@@ -620,6 +626,10 @@ CLI::App* AddDivergence(CLI::App* cli, DivergenceCommand* c) {
       ->capture_default_str()
       ->check(CLI::PositiveNumber);
   divergence->add_option("--out", c->out, "Output CSV [RUN_DIR/divergence.csv]");
+  divergence->add_option("--pair", c->pair,
+                         "The two filters to compare [classical selective, else the first two "
+                         "with a map]")
+      ->expected(2);
   divergence->add_option("--floor-std", c->params.floor_std_m,
                          "Std added to every Gaussian of a filter's map, m (0: its own covariance, the paper's)")
       ->capture_default_str();
@@ -640,6 +650,7 @@ int DivergenceMain(const DivergenceCommand& c) {
   const std::string out = c.out.empty() ? rundir::PathIn(c.run_dir, rundir::kDivergenceFile) : c.out;
   EvaluateOptions options;
   options.divergence = c.params;
+  options.divergence_pair = c.pair;
   options.divergence.ValidateOrThrow();
   WriteDivergenceStudy(c.run_dir, c.num_points, c.realisations, out, options);
   std::fprintf(stderr, "%s: written\n", out.c_str());

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <stdexcept>
 #include <utility>
 
@@ -37,50 +38,77 @@ nlohmann::json Number(double value) {
   return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(nullptr);
 }
 
-// Why the map divergence cannot be computed for a run with filters `names`
-// (it compares the filters classical and selective), or "" when it can.
-std::string NoDivergencePair(const std::vector<std::string>& names, const std::string& run_dir) {
-  const std::vector<std::string>& pair = rundir::DefaultFilterNames();
-  if (std::find(names.begin(), names.end(), pair[0]) != names.end() &&
-      std::find(names.begin(), names.end(), pair[1]) != names.end()) {
-    return "";
-  }
-  std::string got;
-  for (const std::string& name : names) got += (got.empty() ? "" : ", ") + name;
-  return rundir::PathIn(run_dir, rundir::kTrajectoryFile) +
-         ": the map divergence compares the filters " + pair[0] + " and " + pair[1] + " (got " +
-         (got.empty() ? "none" : got) + ")";
+// The names joined by ", " ("none" when empty).
+std::string Joined(const std::vector<std::string>& names) {
+  std::string text;
+  for (const std::string& name : names) text += (text.empty() ? "" : ", ") + name;
+  return text.empty() ? std::string("none") : text;
 }
 
-// The indices of the classical and selective filters among `names`, the
-// pair the map divergence compares; NoDivergencePair must be "".
-std::pair<std::size_t, std::size_t> DivergencePair(const std::vector<std::string>& names) {
-  const std::vector<std::string>& pair = rundir::DefaultFilterNames();
-  return {static_cast<std::size_t>(std::find(names.begin(), names.end(), pair[0]) - names.begin()),
-          static_cast<std::size_t>(std::find(names.begin(), names.end(), pair[1]) - names.begin())};
+std::size_t IndexOf(const std::vector<std::string>& names, const std::string& name) {
+  return static_cast<std::size_t>(std::find(names.begin(), names.end(), name) - names.begin());
 }
 
-// eval::DivergenceStudy of a run's classical and selective maps; its errors
-// (a map with nothing to compare) name the run's map files and its world.
+// eval::DivergenceStudy of two of a run's maps; its errors (a map with
+// nothing to compare) name the run's map files and its world.
 std::vector<eval::DivergenceStatistics> StudyRunMaps(const std::string& run_dir,
-                                                     const eval::Map& classical,
-                                                     const eval::Map& selective,
+                                                     const eval::DivergencePair& pair,
+                                                     const eval::Map& first,
+                                                     const eval::Map& second,
                                                      const eval::Map& truth,
                                                      const std::vector<int>& num_points,
                                                      int realisations, const Rng& rng,
                                                      const eval::DivergenceParams& params) {
-  const std::vector<std::string>& names = rundir::DefaultFilterNames();
   try {
-    return eval::DivergenceStudy(classical, selective, truth, num_points, realisations, rng,
+    return eval::DivergenceStudy(first, second, truth, pair, num_points, realisations, rng,
                                  params);
   } catch (const std::invalid_argument& error) {
-    throw std::runtime_error(rundir::PathIn(run_dir, rundir::MapFile(names[0])) + ", " +
-                             rundir::MapFile(names[1]) + " and the ground truth of " +
+    throw std::runtime_error(rundir::PathIn(run_dir, rundir::MapFile(pair.first)) + ", " +
+                             rundir::MapFile(pair.second) + " and the ground truth of " +
                              rundir::kConfigFile + "'s world: " + error.what());
   }
 }
 
 }  // namespace
+
+std::optional<eval::DivergencePair> ChooseDivergencePair(
+    const std::vector<std::string>& names, const std::function<bool(std::size_t)>& has_mass,
+    const std::vector<std::string>& requested, const std::string& where, std::string* why_not) {
+  if (!requested.empty()) {
+    if (requested.size() != 2) {
+      throw std::runtime_error(where + ": --pair takes two filters (got " +
+                               Joined(requested) + ")");
+    }
+    for (const std::string& name : requested) {
+      if (IndexOf(names, name) == names.size()) {
+        throw std::runtime_error(where + ": --pair: no filter " + name + " in the run (its filters: " +
+                                 Joined(names) + ")");
+      }
+    }
+    if (requested[0] == requested[1]) {
+      throw std::runtime_error(where + ": --pair needs two different filters (got " +
+                               requested[0] + " twice)");
+    }
+    return eval::DivergencePair{requested[0], requested[1]};
+  }
+  const eval::DivergencePair paper;  // classical and selective
+  if (IndexOf(names, paper.first) < names.size() && IndexOf(names, paper.second) < names.size()) {
+    return paper;
+  }
+  std::vector<std::string> with_mass;
+  std::vector<std::string> described;
+  for (std::size_t i = 0; i < names.size(); ++i) {
+    const bool mass = has_mass(i);
+    if (mass) with_mass.push_back(names[i]);
+    described.push_back(names[i] + (mass ? "" : " (nothing to compare)"));
+  }
+  if (with_mass.size() >= 2) return eval::DivergencePair{with_mass[0], with_mass[1]};
+  if (why_not != nullptr) {
+    *why_not = where + ": the map divergence needs two filters whose maps have a corner or a "
+               "seen line (got " + Joined(described) + ")";
+  }
+  return std::nullopt;
+}
 
 eval::Map WorldGroundTruth(const std::string& world, const std::string& robot_model,
                            const eval::GroundTruthParams& params, double max_world_extent_m) {
@@ -166,6 +194,12 @@ RunEvaluation EvaluateRunDirectory(const std::string& run_dir, const EvaluateOpt
     throw std::runtime_error(trajectory.path + ": true_x is nan: no true pose to evaluate against "
                              "(a real log: evaluate the directory mjslam import wrote)");
   }
+  // A --pair the run has not: an error before anything is written.
+  if (!options.divergence_pair.empty()) {
+    ChooseDivergencePair(
+        rundir::TrajectoryFilterNames(trajectory.columns), [](std::size_t) { return true; },
+        options.divergence_pair, trajectory.path);
+  }
   result.truth = RunGroundTruth(run_dir, options.ground_truth);
   rundir::WriteMapCsv(rundir::PathIn(run_dir, rundir::kGroundTruthMapFile), result.truth);
   laps.Charge(&result.cpu.ground_truth_s);
@@ -191,16 +225,21 @@ RunEvaluation EvaluateRunDirectory(const std::string& run_dir, const EvaluateOpt
     result.map.push_back(eval::MatchMaps(maps.back(), result.truth, options.match));
     laps.Charge(&result.cpu.maps_s);
   }
-  result.no_divergence = options.divergence_points > 0 ? NoDivergencePair(result.names, run_dir) : "";
-  if (options.divergence_points > 0 && result.no_divergence.empty()) {
-    const std::uint64_t seed = manifest.value("seed", std::uint64_t{0});
-    const auto [classical, selective] = DivergencePair(result.names);
-    const std::vector<eval::DivergenceStatistics> rows = StudyRunMaps(
-        run_dir, maps[classical], maps[selective], result.truth, {options.divergence_points},
-        options.divergence_realisations, Rng(seed).Fork("evaluate"), options.divergence);
-    result.has_divergence = true;
-    result.divergence = {rows[0].mean, rows[1].mean, rows[2].mean, rows[3].mean};
-    laps.Charge(&result.cpu.divergence_s);
+  if (options.divergence_points > 0) {
+    const std::optional<eval::DivergencePair> pair = ChooseDivergencePair(
+        result.names, [&maps](std::size_t i) { return eval::HasDivergenceMass(maps[i]); },
+        options.divergence_pair, trajectory.path, &result.no_divergence);
+    if (pair) {
+      const std::uint64_t seed = manifest.value("seed", std::uint64_t{0});
+      const std::vector<eval::DivergenceStatistics> rows = StudyRunMaps(
+          run_dir, *pair, maps[IndexOf(result.names, pair->first)],
+          maps[IndexOf(result.names, pair->second)], result.truth, {options.divergence_points},
+          options.divergence_realisations, Rng(seed).Fork("evaluate"), options.divergence);
+      result.has_divergence = true;
+      result.divergence_pair = *pair;
+      result.divergence = {rows[0].mean, rows[1].mean, rows[2].mean, rows[3].mean};
+      laps.Charge(&result.cpu.divergence_s);
+    }
   }
 
   // Merge into summary.json.
@@ -235,12 +274,14 @@ RunEvaluation EvaluateRunDirectory(const std::string& run_dir, const EvaluateOpt
                              {"fraction_above_gate", Number(o.fraction_above_gate)},
                              {"max_nis", Number(o.max_nis)}};
   if (result.has_divergence) {
+    const std::vector<std::string> labels = eval::DivergenceLabels(result.divergence_pair);
+    const eval::MapDivergences& d = result.divergence;
     summary["divergence"] = {{"num_points", options.divergence_points},
                              {"realisations", options.divergence_realisations},
-                             {"classical_selective", result.divergence.classical_selective},
-                             {"selective_classical", result.divergence.selective_classical},
-                             {"classical_truth", result.divergence.classical_truth},
-                             {"selective_truth", result.divergence.selective_truth}};
+                             {labels[0], d.first_second},
+                             {labels[1], d.second_first},
+                             {labels[2], d.first_truth},
+                             {labels[3], d.second_truth}};
   }
   rundir::WriteSummary(run_dir, summary);
   laps.Charge(&result.cpu.summary_s);
@@ -252,7 +293,7 @@ std::vector<eval::DivergenceStatistics> WriteDivergenceStudy(
     const std::string& run_dir, const std::vector<int>& num_points, int realisations,
     const std::string& out_path, const EvaluateOptions& options) {
   const nlohmann::json manifest = rundir::ReadManifest(run_dir);
-  // The classical and selective filters of the run (its trajectory's header).
+  // The run's filters (its trajectory's header), the pair among them.
   const std::string trajectory_path = rundir::PathIn(run_dir, rundir::kTrajectoryFile);
   std::vector<std::string> names;
   if (std::filesystem::exists(trajectory_path)) {
@@ -260,15 +301,20 @@ std::vector<eval::DivergenceStatistics> WriteDivergenceStudy(
   } else {
     names = rundir::DefaultFilterNames();  // maps alone: the default filters'
   }
-  const std::string no_pair = NoDivergencePair(names, run_dir);
-  if (!no_pair.empty()) throw std::runtime_error(no_pair);
+  auto read_map = [&run_dir](const std::string& name) {
+    return rundir::ReadMapCsv(rundir::PathIn(run_dir, rundir::MapFile(name)));
+  };
+  std::string why_not;
+  const std::optional<eval::DivergencePair> pair = ChooseDivergencePair(
+      names, [&](std::size_t i) { return eval::HasDivergenceMass(read_map(names[i])); },
+      options.divergence_pair, trajectory_path, &why_not);
+  if (!pair) throw std::runtime_error(why_not);
   const eval::Map truth = RunGroundTruth(run_dir, options.ground_truth);
-  const std::vector<std::string>& pair = rundir::DefaultFilterNames();
-  const eval::Map classical = rundir::ReadMapCsv(rundir::PathIn(run_dir, rundir::MapFile(pair[0])));
-  const eval::Map selective = rundir::ReadMapCsv(rundir::PathIn(run_dir, rundir::MapFile(pair[1])));
+  const eval::Map first = read_map(pair->first);
+  const eval::Map second = read_map(pair->second);
   const std::uint64_t seed = manifest.value("seed", std::uint64_t{0});
   const std::vector<eval::DivergenceStatistics> rows =
-      StudyRunMaps(run_dir, classical, selective, truth, num_points, realisations,
+      StudyRunMaps(run_dir, *pair, first, second, truth, num_points, realisations,
                    Rng(seed).Fork("divergence"), options.divergence);
   std::string text = rundir::HeaderLine(rundir::DivergenceColumns());
   for (const eval::DivergenceStatistics& row : rows) {

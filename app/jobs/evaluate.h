@@ -1,5 +1,8 @@
 #pragma once
 
+#include <cstddef>
+#include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -25,6 +28,9 @@ struct EvaluateOptions {
   int divergence_points = 20000;
   /// Realisations of the divergence (their mean is reported).
   int divergence_realisations = 1;
+  /// The two filters the divergence compares (`--pair A B`); empty: the
+  /// choice of ChooseDivergencePair.
+  std::vector<std::string> divergence_pair;
 };
 
 /// CPU seconds (of the calling thread) EvaluateRunDirectory spent in each
@@ -57,11 +63,12 @@ struct RunEvaluation {
   std::vector<eval::MapMatchReport> map;
   /// The scans' line observations against the true walls.
   ObservationCheck observations;
-  /// Set when divergence_points > 0 and the run has the filters classical
-  /// and selective, the pair the divergence compares; else, with
+  /// Set when divergence_points > 0 and the run has a pair of filters to
+  /// compare (ChooseDivergencePair), `divergence_pair`; else, with
   /// divergence_points > 0, `no_divergence` says why there is none.
   bool has_divergence = false;
   std::string no_divergence;
+  eval::DivergencePair divergence_pair;
   eval::MapDivergences divergence;
   /// Where the evaluation's CPU time went.
   EvaluationCpu cpu;
@@ -82,6 +89,19 @@ eval::Map WorldGroundTruth(const std::string& world, const std::string& robot_mo
 /// file when the run directory's config or world cannot be loaded.
 eval::Map RunGroundTruth(const std::string& run_dir, const eval::GroundTruthParams& params = {});
 
+/// The two filters of a run the map divergence compares. `names`: the run's
+/// filters in trajectory.csv's order; `has_mass(i)`: whether filter i's map
+/// has something to compare (eval::HasDivergenceMass). `requested` (two
+/// names, `--pair`) when given: both must be filters of the run and differ,
+/// else throws std::runtime_error naming `where` and the run's filters.
+/// Without it: classical and selective when the run has both, else the first
+/// two filters whose maps have something to compare; when fewer than two
+/// have, std::nullopt, and `why_not` (when given) says why, naming `where`.
+std::optional<eval::DivergencePair> ChooseDivergencePair(
+    const std::vector<std::string>& names, const std::function<bool(std::size_t)>& has_mass,
+    const std::vector<std::string>& requested, const std::string& where,
+    std::string* why_not = nullptr);
+
 /// The pose metrics (error, NEES, inside 2 sigma) of filter `name` at every
 /// row of a trajectory.csv table, from its estimate, covariance and truth
 /// columns. A row whose scan the filter skipped (realtime timing,
@@ -99,21 +119,23 @@ std::vector<double> PoseNees(const rundir::CsvTable& trajectory, const std::stri
 /// Evaluates a finished run directory: builds the ground truth
 /// (RunGroundTruth) and writes it to ground_truth_map.csv, compares both
 /// filters' poses (trajectory.csv) and maps (map_<filter>.csv) with the
-/// truth and, when asked, computes the map divergence (seeded from the run's
-/// seed). Merges the results into summary.json (created if missing; other
+/// truth and, when asked, computes the map divergence of two of them
+/// (ChooseDivergencePair; seeded from the run's seed). Merges the results into summary.json (created if missing; other
 /// writers' keys are kept): for each filter `filters.<f>.inside_2sigma`,
 /// `rmse` ({x, y, th}), `mean_nees`, `final_pose_error` ({x, y, th}),
 /// `num_features`, `map` {...}, `observations` {...} (CheckLineObservations
-/// over scans.csv) and `divergence` {...} (docs/commands.md, "mjslam
-/// evaluate"). Files are written atomically. Throws std::runtime_error naming
+/// over scans.csv) and `divergence` {...}, keyed by eval::DivergenceLabels
+/// (docs/run_directory.md). Files are written atomically. Throws std::runtime_error naming
 /// the file for a missing or malformed input.
 RunEvaluation EvaluateRunDirectory(const std::string& run_dir, const EvaluateOptions& options = {});
 
 /// `mjslam divergence`: the paper's Figs. 6 and 7 for one run directory.
 /// For each entry of `num_points`, `realisations` realisations of the four
-/// divergences (eval::DivergenceStudy, seeded from the run's seed), written
-/// to `out_path` as divergence.csv (num_points,pair,mean,variance),
-/// atomically. Returns the rows.
+/// divergences of the pair of filters ChooseDivergencePair gives
+/// (`options.divergence_pair` or its choice; eval::DivergenceStudy, seeded
+/// from the run's seed), written to `out_path` as divergence.csv
+/// (num_points,pair,mean,variance), atomically. Returns the rows. Throws
+/// std::runtime_error when the run has no pair to compare.
 std::vector<eval::DivergenceStatistics> WriteDivergenceStudy(
     const std::string& run_dir, const std::vector<int>& num_points, int realisations,
     const std::string& out_path, const EvaluateOptions& options = {});

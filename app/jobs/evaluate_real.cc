@@ -9,6 +9,7 @@
 #include <Eigen/Eigenvalues>
 
 #include "app/engine/run_config.h"
+#include "rundir/csv_reader.h"
 #include "rundir/layout.h"
 #include "rundir/manifest.h"
 #include "rundir/map_csv.h"
@@ -22,14 +23,17 @@ using realdata::Relation;
 using realdata::RelationErrors;
 using realdata::TimedPose;
 
-// The filters' columns of a trajectory read back: the filters' estimates
-// are what an imported run is scored on. Throws std::runtime_error naming the
-// file when it has none (a trajectory written by the import, before its
-// replay).
-void RequireFilters(const std::vector<rundir::TrajectoryRow>& trajectory, const std::string& path) {
-  std::vector<std::string> names;
-  for (const rundir::FilterRow& f : trajectory.front().filters) names.push_back(f.name);
-  rundir::RequireDefaultFilters(names, path, "the evaluation of an imported log");
+// The filters of an imported run's trajectory.csv (its header's): the
+// filters' estimates are what it is scored on. Throws std::runtime_error
+// naming the file when it has none (a trajectory written by the import,
+// before its replay).
+std::vector<std::string> FilterNames(const std::string& path) {
+  std::vector<std::string> names = rundir::TrajectoryFilterNames(rundir::ReadCsvHeader(path));
+  if (names.empty()) {
+    throw std::runtime_error(path + ": no filter columns (<name>_x, ...) for the evaluation of "
+                             "an imported log to score");
+  }
+  return names;
 }
 
 // The poses of the robot centre B of the trajectory `track` (0 odometry, 1 +
@@ -72,7 +76,7 @@ nlohmann::json ToJson(const std::vector<ScoredTrajectory>& scored) {
 }
 
 // Counts the rows whose pose covariance of filter `filter` (in the order of
-// DefaultFilterNames()) is not positive semi-definite, and those where it is
+// trajectory.csv's filters) is not positive semi-definite, and those where it is
 // singular (the file holds the upper triangle: symmetric by construction).
 std::pair<int, int> CovarianceDefects(const std::vector<rundir::TrajectoryRow>& trajectory,
                                       std::size_t filter) {
@@ -129,17 +133,22 @@ RealEvaluation EvaluateImportedRun(const std::string& run_dir) {
   const RunConfig config = LoadRunConfig(rundir::PathIn(run_dir, rundir::kConfigFile), {});
   const Pose2 X_RB(-config.slam.ekf.control_point_offset_m, 0.0, 0.0);
   const std::string trajectory_path = rundir::PathIn(run_dir, rundir::kTrajectoryFile);
+  const std::vector<std::string> filters = FilterNames(trajectory_path);
   const std::vector<rundir::TrajectoryRow> trajectory = rundir::ReadTrajectoryRows(trajectory_path);
-  RequireFilters(trajectory, trajectory_path);
   std::set<double> scan_times;
   for (const rundir::ScanRow& scan : rundir::ReadScanRows(ImportedScansPath(run_dir))) {
     scan_times.insert(scan.t_s);
   }
 
   RealEvaluation result;
-  // The trajectories scored, by their track in PosesOf.
-  const std::vector<std::string> names = {"classical", "selective", "odometry"};
-  const std::vector<int> tracks = {1, 2, 0};
+  result.filter_names = filters;
+  // The trajectories scored, by their track in PosesOf: the filters, then
+  // the odometry.
+  std::vector<std::string> names = filters;
+  names.push_back("odometry");
+  std::vector<int> tracks;
+  for (std::size_t f = 0; f < filters.size(); ++f) tracks.push_back(static_cast<int>(f) + 1);
+  tracks.push_back(0);
   const std::string reference_path = rundir::PathIn(run_dir, rundir::kReferenceFile);
   const bool has_reference =
       manifest.value("reference", std::string("none")) != "none";
@@ -193,13 +202,12 @@ RealEvaluation EvaluateImportedRun(const std::string& run_dir) {
       result.vs_reference_lags.push_back(scored);
     }
   }
-  for (std::size_t f = 0; f < rundir::DefaultFilterNames().size(); ++f) {
+  for (std::size_t f = 0; f < filters.size(); ++f) {
     const auto [not_psd, singular] = CovarianceDefects(trajectory, f);
     result.not_positive_semidefinite.push_back(not_psd);
     result.singular.push_back(singular);
     result.num_features.push_back(static_cast<int>(
-        rundir::ReadMapCsv(rundir::PathIn(run_dir, rundir::MapFile(rundir::DefaultFilterNames()[f])))
-            .size()));
+        rundir::ReadMapCsv(rundir::PathIn(run_dir, rundir::MapFile(filters[f]))).size()));
   }
 
   const std::string summary_path = rundir::PathIn(run_dir, rundir::kSummaryFile);

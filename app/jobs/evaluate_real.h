@@ -18,13 +18,18 @@ std::string ImportedScansPath(const std::string& run_dir);
 
 /// The relation metric of one trajectory on one set of relations.
 struct ScoredTrajectory {
-  /// "classical", "selective", "odometry" or "reference".
+  /// A filter's name (trajectory.csv's), "odometry" or "reference".
   std::string name;
   realdata::RelationErrors errors;
 };
 
 /// What EvaluateImportedRun found (docs/real_data.md, "Scoring").
 struct RealEvaluation {
+  /// The run's filters, from trajectory.csv's header, in its order: the
+  /// order of the filters in the sets below (each set: the filters, then
+  /// the odometry, then the reference where it is scored) and in the
+  /// per-filter lists.
+  std::vector<std::string> filter_names;
   /// On the relations file (empty without one), poses at the scans: the
   /// filters, the odometry and the reference (when there is one), each on
   /// the same relations.
@@ -43,7 +48,7 @@ struct RealEvaluation {
   int relation_times_at_scans = 0;
   double time_offset_s = 0.0;
   double tolerance_s = 0.0;
-  /// Per filter (classical, selective): rows whose pose covariance is not
+  /// Per filter of filter_names: rows whose pose covariance is not
   /// positive semi-definite (an eigenvalue below -1e-9 of the largest), rows
   /// where it is singular (the smallest eigenvalue at most 1e-9 of the
   /// largest: the known start, and the first steps, before a turn makes the

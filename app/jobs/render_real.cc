@@ -2,14 +2,17 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <map>
 #include <stdexcept>
 
 #include "app/jobs/evaluate_real.h"
 #include "app/engine/run_config.h"
 #include "common/interrupt.h"
+#include "renders/filter_colors.h"
 #include "renders/plan_canvas.h"
 #include "renders/video_writer.h"
+#include "rundir/csv_reader.h"
 #include "rundir/layout.h"
 #include "rundir/manifest.h"
 #include "rundir/map_csv.h"
@@ -30,7 +33,7 @@ const Rgb kCorner = {200, 0, 160};
 const Rgb kRobot = {220, 0, 0};
 
 // One trajectory of the run: which (0 odometry, 1 + f filter f in the order
-// of rundir::DefaultFilterNames()), its colours and map file.
+// of trajectory.csv's filters), its colours and map file.
 struct Track {
   int index;
   Rgb path;
@@ -38,17 +41,30 @@ struct Track {
   std::string map_name;  // empty: no map (odometry)
 };
 
-const std::vector<Track>& Tracks() {
-  static const std::vector<Track> kTracks = {
-      {0, {200, 40, 40}, {235, 160, 160}, ""},
-      {1, {230, 120, 20}, {245, 190, 140}, "classical"},
-      {2, {30, 90, 200}, {150, 180, 235}, "selective"}};
-  return kTracks;
+// The odometry's track, then one per filter of `names`, coloured as the
+// renders of simulated runs colour it (renders::FilterColors), its scan
+// points that colour faded 60 % towards white.
+std::vector<Track> Tracks(const std::vector<std::string>& names) {
+  std::vector<Track> tracks = {{0, {200, 40, 40}, {235, 160, 160}, ""}};
+  const std::vector<std::array<float, 3>> colors = renders::FilterColors(names);
+  for (std::size_t f = 0; f < names.size(); ++f) {
+    Rgb path, points;
+    for (int c = 0; c < 3; ++c) {
+      const double v = 255.0 * colors[f][c];
+      path[c] = static_cast<std::uint8_t>(std::lround(v));
+      points[c] = static_cast<std::uint8_t>(std::lround(v + 0.6 * (255.0 - v)));
+    }
+    tracks.push_back({static_cast<int>(f) + 1, path, points, names[f]});
+  }
+  return tracks;
 }
 
 // The files of the run, read once.
 struct RealRun {
   RunConfig config;
+  // The filters, from trajectory.csv's header, and the tracks drawn.
+  std::vector<std::string> names;
+  std::vector<Track> tracks;
   Pose2 X_RS;
   std::vector<rundir::TrajectoryRow> trajectory;
   std::string scans_path;
@@ -65,10 +81,13 @@ RealRun ReadRealRun(const std::string& dir) {
   if (!mount) throw std::runtime_error(rundir::PathIn(dir, rundir::kManifestFile) + ": no laser_mount");
   run.X_RS = *mount;
   const std::string trajectory_path = rundir::PathIn(dir, rundir::kTrajectoryFile);
+  run.names = rundir::TrajectoryFilterNames(rundir::ReadCsvHeader(trajectory_path));
+  if (run.names.empty()) {
+    throw std::runtime_error(trajectory_path + ": no filter columns (<name>_x, ...) to render "
+                             "(a trajectory written by the import, before its replay?)");
+  }
   run.trajectory = rundir::ReadTrajectoryRows(trajectory_path);
-  std::vector<std::string> names;
-  for (const rundir::FilterRow& f : run.trajectory.front().filters) names.push_back(f.name);
-  rundir::RequireDefaultFilters(names, trajectory_path, "the render of an imported log");
+  run.tracks = Tracks(run.names);
   run.scans_path = ImportedScansPath(dir);
   run.scans = rundir::ReadScanRows(run.scans_path);
   for (std::size_t i = 0; i < run.trajectory.size(); ++i) run.row_at[run.trajectory[i].t_s] = i;
@@ -108,12 +127,16 @@ std::vector<Eigen::Vector2d> ScanPoints(const RealRun& run, const Track& track, 
   return points;
 }
 
-// The window: the 0.5 and 99.5 percentiles of the selective filter's
-// points, so that a few stray long beams do not shrink the building.
+// The window: the 0.5 and 99.5 percentiles of the selective filter's points
+// (without one, the last filter's), so that a few stray long beams do not
+// shrink the building.
 std::pair<Eigen::Vector2d, Eigen::Vector2d> Window(const RealRun& run) {
+  const auto selective = std::find(run.names.begin(), run.names.end(), "selective");
+  const std::size_t framing =
+      selective != run.names.end() ? selective - run.names.begin() : run.names.size() - 1;
   std::vector<double> xs, ys;
   for (std::size_t k = 0; k < run.scans.size(); ++k) {
-    for (const Eigen::Vector2d& p : ScanPoints(run, Tracks()[2], k)) {
+    for (const Eigen::Vector2d& p : ScanPoints(run, run.tracks[framing + 1], k)) {
       xs.push_back(p.x());
       ys.push_back(p.y());
     }
@@ -185,39 +208,43 @@ int RenderImportedRun(const std::string& run_dir, const renders::RenderParams& p
   const auto [min, max] = Window(run);
   const int side = params.height - params.height % 2;
   std::vector<PlanCanvas> panels;
-  for (const Track& track : Tracks()) {
+  for (const Track& track : run.tracks) {
     ThrowIfInterrupted("render");
     panels.emplace_back(side, side, min, max);
     DrawReference(run, &panels.back());
     AddScans(run, track, 0, num_scans, &panels.back());
     if (!track.map_name.empty()) DrawMap(run_dir, track.map_name, &panels.back());
   }
-  renders::WritePng(rundir::PathIn(run_dir, rundir::kFinalImageFile),
-                    SideBySide({&panels[0].image(), &panels[1].image(), &panels[2].image()}));
+  std::vector<const renders::Image*> images;
+  for (const PlanCanvas& panel : panels) images.push_back(&panel.image());
+  renders::WritePng(rundir::PathIn(run_dir, rundir::kFinalImageFile), SideBySide(images));
   if (!params.video) return 0;
 
   // The video: the filters' panels growing scan by scan.
+  const std::size_t num_filters = run.names.size();
   std::vector<PlanCanvas> growing;
-  for (int f = 1; f <= 2; ++f) {
+  for (std::size_t f = 0; f < num_filters; ++f) {
     growing.emplace_back(side, side, min, max);
     DrawReference(run, &growing.back());
   }
-  renders::VideoWriter video(rundir::PathIn(run_dir, rundir::kVideoFile), 2 * side, side,
-                             params.fps, params.crf);
+  renders::VideoWriter video(rundir::PathIn(run_dir, rundir::kVideoFile),
+                             static_cast<int>(num_filters) * side, side, params.fps, params.crf);
   const std::size_t stride = (num_scans + kMaxVideoFrames - 1) / kMaxVideoFrames;
   for (std::size_t from = 0; from < num_scans; from += stride) {
     // A stop leaves no video (the writer removes its temporary file).
     ThrowIfInterrupted("render");
     const std::size_t to = std::min(num_scans, from + stride);
     std::vector<PlanCanvas> frame;
-    for (int f = 0; f < 2; ++f) {
-      const Track& track = Tracks()[f + 1];
+    for (std::size_t f = 0; f < num_filters; ++f) {
+      const Track& track = run.tracks[f + 1];
       AddScans(run, track, from, to, &growing[f]);
       frame.push_back(growing[f]);
       const std::size_t row = run.row_at.at(run.scans[to - 1].t_s);
       frame.back().Dot(PoseAt(run, track, row).translation(), kRobot, 3);
     }
-    video.AddFrame(SideBySide({&frame[0].image(), &frame[1].image()}));
+    std::vector<const renders::Image*> frame_images;
+    for (const PlanCanvas& panel : frame) frame_images.push_back(&panel.image());
+    video.AddFrame(SideBySide(frame_images));
   }
   video.Finish();
   return video.frames();

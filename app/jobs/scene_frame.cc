@@ -2,28 +2,17 @@
 
 #include <algorithm>
 #include <cmath>
-#include <iterator>
+
+#include "renders/filter_colors.h"
 
 namespace mjslam::app {
 
 std::vector<renders::FilterLayer> FilterLayers(const std::vector<std::string>& names) {
-  // The other filters' colours, in turn: teal, brown, olive, pink, grey.
-  static const renders::Rgb kOthers[] = {{0.00f, 0.60f, 0.60f},
-                                         {0.55f, 0.30f, 0.10f},
-                                         {0.50f, 0.55f, 0.00f},
-                                         {0.95f, 0.40f, 0.65f},
-                                         {0.50f, 0.50f, 0.50f}};
+  const std::vector<std::array<float, 3>> colors = renders::FilterColors(names);
   std::vector<renders::FilterLayer> layers(names.size());
-  std::size_t next_other = 0;
   for (std::size_t i = 0; i < names.size(); ++i) {
     layers[i].name = names[i];
-    if (names[i] == "classical") {
-      layers[i].color = renders::colors::kClassical;
-    } else if (names[i] == "selective") {
-      layers[i].color = renders::colors::kSelective;
-    } else {
-      layers[i].color = kOthers[next_other++ % std::size(kOthers)];
-    }
+    layers[i].color = colors[i];
   }
   return layers;
 }

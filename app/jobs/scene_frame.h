@@ -14,8 +14,9 @@ namespace mjslam::app {
 /// Pieces of a renders::SceneFrame shared by `mjslam render` (from a run's
 /// files) and the video `mjslam run` renders as it goes (from its state).
 
-/// One layer per filter of `names`, in order, named and coloured: classical
-/// orange, selective blue, any other the next colour of a fixed palette.
+/// One layer per filter of `names`, in order, named and coloured
+/// (renders::FilterColors: classical orange, selective blue, any other the
+/// next colour of a fixed palette).
 std::vector<renders::FilterLayer> FilterLayers(const std::vector<std::string>& names);
 
 /// The length of one pixel of `renderer`'s view, metres: paths keep a point

@@ -39,7 +39,7 @@ __all__ = [
     "read_run", "read_sweep", "read_csv", "read_header", "read_trajectory", "read_scans",
     "read_explorer", "read_map", "read_reference", "read_divergence", "read_nees",
     "read_json_object", "read_config", "config_value", "check_columns",
-    "check_increasing_times", "divergence_by_pair", "wrap_angle",
+    "check_increasing_times", "divergence_by_pair", "divergence_pair", "wrap_angle",
 ]
 
 # ---------------------------------------------------------------------------------------------
@@ -388,7 +388,8 @@ def read_reference(path):
 
 
 def read_divergence(path):
-    """divergence.csv: num_points, pair (text: classical_selective, ...), mean, variance."""
+    """divergence.csv: num_points, pair (text: `<a>_<b>`, `<b>_<a>`, `<a>_truth`, `<b>_truth` of
+    the two filters compared, classical_selective, ... by default), mean, variance."""
     table = read_csv(path, text_columns=("pair",))
     check_columns(table, DIVERGENCE_COLUMNS)
     return table
@@ -400,6 +401,19 @@ def read_nees(path):
     names = [c[:-len("_anees")] for c in table.columns if c.endswith("_anees")]
     check_columns(table, ("t",) + tuple(n + "_anees" for n in names) + NEES_COLUMNS[-3:])
     return table
+
+
+def divergence_pair(table):
+    """The two filters (a, b) a divergence table compares, from its `<a>_truth`, `<b>_truth` rows
+    in their order (filter names may hold '_': the other labels cannot say)."""
+    pair = []
+    for label in table["pair"].tolist():
+        if label.endswith("_truth") and label[:-len("_truth")] not in pair:
+            pair.append(label[:-len("_truth")])
+    if len(pair) != 2:
+        raise RunFormatError("%s: pair: expected the rows of two filters' <name>_truth (got %s)"
+                             % (table.path, ", ".join(pair) or "none"))
+    return tuple(pair)
 
 
 def divergence_by_pair(table):

@@ -1,10 +1,13 @@
 // The paper's map divergence: mixtures, pmfs and Kullback-Leibler divergence.
 #include "eval/map_divergence.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
 #include <random>
+#include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 
@@ -105,11 +108,11 @@ TEST(MapDivergenceTest, DivergenceGrowsWithTheMapErrorAndIsAsymmetric) {
   for (int k = 0; k < 5; ++k) {
     Rng rng = root.Fork("r" + std::to_string(k));
     const MapDivergences d = ComputeMapDivergences(near, far, t, 2000, &rng);
-    EXPECT_LT(d.classical_truth, d.selective_truth) << k;
-    EXPECT_GE(d.classical_truth, 0.0);
-    EXPECT_GT(d.classical_selective, 0.0);
-    EXPECT_GT(d.selective_classical, 0.0);
-    EXPECT_NE(d.classical_selective, d.selective_classical);
+    EXPECT_LT(d.first_truth, d.second_truth) << k;
+    EXPECT_GE(d.first_truth, 0.0);
+    EXPECT_GT(d.first_second, 0.0);
+    EXPECT_GT(d.second_first, 0.0);
+    EXPECT_NE(d.first_second, d.second_first);
   }
 }
 
@@ -118,8 +121,11 @@ TEST(MapDivergenceTest, StudyIsReproducibleRowByRow) {
   const Map a = Shifted(truth, {0.02, 0.0}, 1e-4);
   const Map b = Shifted(truth, {0.0, 0.03}, 2e-4);
   const Rng rng(3);
-  const std::vector<DivergenceStatistics> first = DivergenceStudy(a, b, truth, {100, 1000}, 5, rng);
-  const std::vector<DivergenceStatistics> second = DivergenceStudy(a, b, truth, {100, 1000}, 5, rng);
+  const DivergencePair pair;  // classical, selective
+  const std::vector<DivergenceStatistics> first =
+      DivergenceStudy(a, b, truth, pair, {100, 1000}, 5, rng);
+  const std::vector<DivergenceStatistics> second =
+      DivergenceStudy(a, b, truth, pair, {100, 1000}, 5, rng);
   ASSERT_EQ(first.size(), 8u);
   for (std::size_t i = 0; i < first.size(); ++i) {
     EXPECT_EQ(first[i].mean, second[i].mean);  // bit for bit
@@ -129,14 +135,58 @@ TEST(MapDivergenceTest, StudyIsReproducibleRowByRow) {
   EXPECT_EQ(first[3].pair, "selective_truth");
   EXPECT_EQ(first[4].num_points, 1000);
   // Each #E has its own streams: a study of 1000 points alone gives the same.
-  const std::vector<DivergenceStatistics> alone = DivergenceStudy(a, b, truth, {1000}, 5, rng);
+  const std::vector<DivergenceStatistics> alone = DivergenceStudy(a, b, truth, pair, {1000}, 5, rng);
   for (int p = 0; p < 4; ++p) EXPECT_EQ(alone[p].mean, first[4 + p].mean);
   for (const DivergenceStatistics& row : first) {
     EXPECT_GT(row.mean, 0.0);
     EXPECT_GT(row.variance, 0.0);
   }
-  EXPECT_THROW(DivergenceStudy(a, b, truth, {0}, 2, rng), std::invalid_argument);
-  EXPECT_THROW(DivergenceStudy(a, b, truth, {10}, 0, rng), std::invalid_argument);
+  EXPECT_THROW(DivergenceStudy(a, b, truth, pair, {0}, 2, rng), std::invalid_argument);
+  EXPECT_THROW(DivergenceStudy(a, b, truth, pair, {10}, 0, rng), std::invalid_argument);
+}
+
+// Any two maps by name: the rows are labelled by the pair's names, and the
+// numbers are those of the same maps under the default names (the streams do
+// not depend on the names).
+TEST(MapDivergenceTest, RowsAreLabelledByThePairsNames) {
+  const Map truth = Room();
+  const Map a = Shifted(truth, {0.02, 0.0}, 1e-4);
+  const Map b = Shifted(truth, {0.0, 0.03}, 2e-4);
+  const Rng rng(3);
+  const DivergencePair named{"dead_reckoning", "ekf_b"};
+  EXPECT_EQ(DivergenceLabels(named),
+            (std::vector<std::string>{"dead_reckoning_ekf_b", "ekf_b_dead_reckoning",
+                                      "dead_reckoning_truth", "ekf_b_truth"}));
+  EXPECT_EQ(DivergenceLabels(DivergencePair{}),
+            (std::vector<std::string>{"classical_selective", "selective_classical",
+                                      "classical_truth", "selective_truth"}));
+  const std::vector<DivergenceStatistics> rows = DivergenceStudy(a, b, truth, named, {100}, 3, rng);
+  const std::vector<DivergenceStatistics> paper =
+      DivergenceStudy(a, b, truth, DivergencePair{}, {100}, 3, rng);
+  ASSERT_EQ(rows.size(), 4u);
+  for (int p = 0; p < 4; ++p) {
+    EXPECT_EQ(rows[p].pair, DivergenceLabels(named)[p]);
+    EXPECT_EQ(rows[p].mean, paper[p].mean);
+    EXPECT_EQ(rows[p].variance, paper[p].variance);
+  }
+  // A map with nothing to compare is an error naming it by its name.
+  Map unseen = a;
+  for (MapFeature& f : unseen) f.has_segment = false;
+  unseen.erase(std::remove_if(unseen.begin(), unseen.end(),
+                              [](const MapFeature& f) {
+                                return f.type == MapFeature::Type::kCorner;
+                              }),
+               unseen.end());
+  EXPECT_TRUE(HasDivergenceMass(a));
+  EXPECT_FALSE(HasDivergenceMass(unseen));
+  EXPECT_FALSE(HasDivergenceMass(Map{}));
+  try {
+    DivergenceStudy(a, unseen, truth, named, {100}, 3, rng);
+    FAIL() << "no error";
+  } catch (const std::invalid_argument& error) {
+    EXPECT_EQ(std::string(error.what()),
+              "divergence: the ekf_b map has no corner and no line with a segment");
+  }
 }
 
 TEST(MapDivergenceTest, FloorsByRoleAndWeightsByOption) {
@@ -203,8 +253,10 @@ TEST(MapDivergenceTest, BothFloorsRankAMapThreeMillimetresOffAboveOneOneMillimet
   own.floor_std_m = 0.0;
   own.truth_std_m = 0.001;
   const Rng rng(9);
-  const std::vector<DivergenceStatistics> a = DivergenceStudy(near, far, truth, {10000}, 3, rng, floored);
-  const std::vector<DivergenceStatistics> b = DivergenceStudy(near, far, truth, {10000}, 3, rng, own);
+  const std::vector<DivergenceStatistics> a =
+      DivergenceStudy(near, far, truth, DivergencePair{}, {10000}, 3, rng, floored);
+  const std::vector<DivergenceStatistics> b =
+      DivergenceStudy(near, far, truth, DivergencePair{}, {10000}, 3, rng, own);
   // Rows: classical_selective, selective_classical, classical_truth (near), selective_truth (far).
   EXPECT_LT(a[2].mean, 0.01);
   EXPECT_GT(a[3].mean / a[2].mean, 7.0) << a[2].mean << " " << a[3].mean;

@@ -163,6 +163,77 @@ TEST(DivergenceCommandTest, WritesMeanAndVariancePerPointsAndPair) {
   EXPECT_EQ(ReadText(dir + "/again.csv"), first);
 }
 
+// A run of four named filters, none called classical or selective: dr
+// (dead reckoning, an empty map) and three EKFs a, b, c. The divergence
+// compares the first two with a map (a, b), or the pair --pair names; its
+// labels, summary.json's keys and the printed line go by those names.
+TEST(DivergenceCommandTest, ComparesAPairOfFiltersByName) {
+  const std::string dir = FreshDir("divergence_named") + "/run";
+  ASSERT_EQ(Shell(Program() + " run --quiet --no-render --config " + DefaultConfig() +
+                  " --world " + Room() + " --duration 6 --seed 2 --out " + dir +
+                  " --set 'slam.filters=[{name: dr, kind: dead_reckoning}, {name: a, update: "
+                  "classical}, {name: b, update: selective}, {name: c, update: classical, "
+                  "process_noise_scale: 2}]' --set control.pose_source=b 2> " + dir + ".log"),
+            0)
+      << ReadText(dir + ".log");
+  // The run's own evaluation: a and b (dr's map has nothing to compare).
+  nlohmann::json summary = nlohmann::json::parse(ReadText(rundir::PathIn(dir, rundir::kSummaryFile)));
+  for (const char* key : {"a_b", "b_a", "a_truth", "b_truth"}) {
+    EXPECT_TRUE(summary["divergence"].contains(key)) << key << " " << summary["divergence"];
+  }
+  EXPECT_EQ(summary["divergence"].size(), 6u) << summary["divergence"];  // + num_points, realisations
+
+  // --pair c a: the keys are c's and a's, replacing the last divergence.
+  ASSERT_EQ(Shell(Program() + " evaluate " + dir + " --divergence-points 300 --pair c a > " + dir +
+                  ".eval.log 2>&1"),
+            0)
+      << ReadText(dir + ".eval.log");
+  summary = nlohmann::json::parse(ReadText(rundir::PathIn(dir, rundir::kSummaryFile)));
+  EXPECT_EQ(summary["divergence"].size(), 6u) << summary["divergence"];
+  for (const char* key : {"c_a", "a_c", "c_truth", "a_truth"}) {
+    EXPECT_GE(summary["divergence"][key].get<double>(), 0.0) << key;
+  }
+  EXPECT_NE(ReadText(dir + ".eval.log").find("divergence: c||a "), std::string::npos)
+      << ReadText(dir + ".eval.log");
+
+  // mjslam divergence: a and b by default, then b and c.
+  auto labels = [&dir](const std::string& options) {
+    EXPECT_EQ(Shell(Program() + " divergence " + dir + " --points 100 --realisations 2 " +
+                    options + " 2> " + dir + ".div.log"),
+              0)
+        << ReadText(dir + ".div.log");
+    const rundir::CsvTable table = rundir::ReadCsv(dir + "/divergence.csv", {"pair"});
+    std::vector<std::string> pairs;
+    for (const std::vector<std::string>& text : table.text) pairs.push_back(text[0]);
+    return pairs;
+  };
+  EXPECT_EQ(labels(""), (std::vector<std::string>{"a_b", "b_a", "a_truth", "b_truth"}));
+  EXPECT_EQ(labels("--pair b c"), (std::vector<std::string>{"b_c", "c_b", "b_truth", "c_truth"}));
+
+  // A pair the run has not, the same filter twice, or an empty map: errors
+  // naming them, summary.json as it was.
+  const std::string before = ReadText(rundir::PathIn(dir, rundir::kSummaryFile));
+  for (const std::string command : {"evaluate", "divergence"}) {
+    const std::string log = dir + "." + command + ".bad.log";
+    EXPECT_EQ(Shell(Program() + " " + command + " " + dir + " --pair a x > " + log + " 2>&1"), 1);
+    EXPECT_NE(ReadText(log).find("trajectory.csv: --pair: no filter x in the run (its filters: dr, "
+                                 "a, b, c)"),
+              std::string::npos)
+        << ReadText(log);
+    EXPECT_EQ(Shell(Program() + " " + command + " " + dir + " --pair b b > " + log + " 2>&1"), 1);
+    EXPECT_NE(ReadText(log).find("--pair needs two different filters (got b twice)"),
+              std::string::npos)
+        << ReadText(log);
+    EXPECT_NE(Shell(Program() + " " + command + " " + dir + " --pair a > " + log + " 2>&1"), 0);
+    EXPECT_EQ(Shell(Program() + " " + command + " " + dir + " --pair dr a > " + log + " 2>&1"), 1);
+    EXPECT_NE(ReadText(log).find("map_dr.csv, map_a.csv and the ground truth of config.yaml's "
+                                 "world: divergence: the dr map has no corner and no line"),
+              std::string::npos)
+        << ReadText(log);
+  }
+  EXPECT_EQ(ReadText(rundir::PathIn(dir, rundir::kSummaryFile)), before);
+}
+
 class SweepTest : public ::testing::Test {
  protected:
   static app::RunConfig Config() {

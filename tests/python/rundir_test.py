@@ -250,6 +250,7 @@ def test_maps_explorer_and_divergence(run):
                                     "classical_truth", "selective_truth"])
     assert all([r[0] for r in rows] == [100, 200] for rows in table.values())
     assert all(isinstance(r[0], int) and isinstance(r[1], float) for r in table["classical_truth"])
+    assert mjslam.divergence_pair(run.divergence) == ("classical", "selective")
 
 
 def test_sweep(sweep):
@@ -274,6 +275,13 @@ def test_named_filters(out):
     assert set(run.maps) == set(run.filter_names) and len(run.maps["dead_reckoning"]) == 0
     assert run.errors("dead_reckoning").shape == (len(run.trajectory), 3)
     assert set(run.summary["filters"]) == set(run.filter_names)
+    # The divergence of a pair named on the command line, its labels by name.
+    program("divergence", path, "--points", "100", "--realisations", "2",
+            "--pair", "selective", "classical")
+    divergence = mjslam.read_run(path).divergence
+    assert mjslam.divergence_pair(divergence) == ("selective", "classical")
+    assert list(divergence["pair"]) == ["selective_classical", "classical_selective",
+                                        "selective_truth", "classical_truth"]
     sweep_path = str(out / "named_sweep")
     program("sweep", "--quiet", "--config", "examples/dead_reckoning.yaml", "--runs", "2",
             "--jobs", "2", "--duration", "2", "--set", "render.enabled=false",
@@ -282,6 +290,18 @@ def test_named_filters(out):
     sweep = mjslam.read_sweep(sweep_path)
     assert sweep.nees.columns == ("t", "a_anees", "dr_anees", "lower", "upper", "n_runs")
     assert sweep.runs[0].filter_names == ("a", "dr")
+
+
+def test_divergence_pair_of_names_with_underscores(tmp_path):
+    path = tmp_path / "divergence.csv"
+    path.write_text("num_points,pair,mean,variance\n"
+                    "10,dead_reckoning_ekf_b,1,0\n10,ekf_b_dead_reckoning,1,0\n"
+                    "10,dead_reckoning_truth,1,0\n10,ekf_b_truth,1,0\n")
+    table = mjslam.read_divergence(str(path))
+    assert mjslam.divergence_pair(table) == ("dead_reckoning", "ekf_b")
+    path.write_text("num_points,pair,mean,variance\n10,a_b,1,0\n10,a_truth,1,0\n")
+    with pytest.raises(mjslam.RunFormatError, match="divergence.csv: pair: expected"):
+        mjslam.divergence_pair(mjslam.read_divergence(str(path)))
 
 
 def test_imported_log(imported):

@@ -138,15 +138,6 @@ TEST(LayoutTest, FilterNamesComeFromTheTrajectoryHeader) {
   EXPECT_EQ(TrajectoryFilterNames(TrajectoryColumns()), DefaultFilterNames());
   EXPECT_TRUE(TrajectoryFilterNames(RecordedTrajectoryColumns()).empty());
   EXPECT_EQ(HeaderLine(NeesColumns({"a", "b", "c"})), "t,a_anees,b_anees,c_anees,lower,upper,n_runs\n");
-  EXPECT_NO_THROW(RequireDefaultFilters(DefaultFilterNames(), "f", "this"));
-  try {
-    RequireDefaultFilters({"classical", "other"}, "dir/trajectory.csv", "the render");
-    FAIL() << "no error";
-  } catch (const std::runtime_error& error) {
-    EXPECT_EQ(std::string(error.what()),
-              "dir/trajectory.csv: the render supports only the filters classical, selective "
-              "(got classical, other)");
-  }
 }
 
 TEST(LayoutTest, HeaderLineJoinsTheColumns) {
