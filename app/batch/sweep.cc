@@ -26,7 +26,6 @@ namespace mjslam::app {
 namespace {
 
 namespace fs = std::filesystem;
-using rundir::CsvTable;
 using rundir::FormatDouble;
 using rundir::PathIn;
 using rundir::ReadJsonFile;
@@ -420,7 +419,7 @@ std::vector<std::string> SweepFilterNames(const std::vector<std::string>& run_di
   for (std::size_t r = 0; r < run_dirs.size(); ++r) {
     const std::string path = PathIn(run_dirs[r], rundir::kTrajectoryFile);
     const std::vector<std::string> run_names =
-        rundir::TrajectoryFilterNames(rundir::ReadCsv(path).columns);
+        rundir::TrajectoryFilterNames(rundir::ReadCsvHeader(path));
     if (r == 0) {
       names = run_names;
     } else if (run_names != names) {
@@ -447,36 +446,36 @@ SweepRuns ReadSweepRuns(const std::vector<std::string>& run_dirs) {
   runs.max_period_s.resize(names.size());
   runs.inside_2sigma_pooled.assign(names.size(), {0, 0, 0, 0});
   for (const std::string& run_dir : run_dirs) {
-    const CsvTable table = rundir::ReadCsv(PathIn(run_dir, rundir::kTrajectoryFile));
-    const int t = table.ColumnIndex("t");
+    const std::vector<rundir::TrajectoryRow> trajectory =
+        rundir::ReadTrajectoryRows(PathIn(run_dir, rundir::kTrajectoryFile));
     std::vector<double> run_times;
-    for (const std::vector<double>& row : table.rows) run_times.push_back(row[t]);
+    for (const rundir::TrajectoryRow& row : trajectory) run_times.push_back(row.t_s);
     runs.times.push_back(run_times);
+    // Only when the trajectory has the truth (not a recording without it).
+    const bool has_truth = !trajectory.empty() && !std::isnan(trajectory[0].X_WR_true.x);
     for (std::size_t f = 0; f < names.size(); ++f) {
-      runs.nees[f].push_back(PoseNees(table, names[f]));
-      // Only when the trajectory has the truth and the covariance.
-      const bool has_pose = std::find(table.columns.begin(), table.columns.end(), "true_x") !=
-                                table.columns.end() &&
-                            std::find(table.columns.begin(), table.columns.end(),
-                                      names[f] + "_pxx") != table.columns.end();
+      runs.nees[f].push_back(PoseNees(trajectory, f));
       for (const eval::PoseStepMetrics& m :
-           has_pose ? PoseSteps(table, names[f]) : std::vector<eval::PoseStepMetrics>{}) {
+           has_truth ? PoseSteps(trajectory, f) : std::vector<eval::PoseStepMetrics>{}) {
         for (int k = 0; k < 3; ++k) runs.inside_2sigma_pooled[f][k] += m.inside_2sigma[k] ? 1 : 0;
         ++runs.inside_2sigma_pooled[f][3];
       }
-      const int us = table.ColumnIndex(names[f] + "_us");
       double total_us = 0.0;
-      for (const std::vector<double>& row : table.rows) total_us += row[us];
-      runs.processing_s[f].push_back(total_us * 1e-6);
-      // Open loop: the run's accumulated f_open_loop at its last step.
-      for (std::size_t c = 0; c < table.columns.size(); ++c) {
-        if (table.columns[c] == names[f] + "_open_loop" && !table.rows.empty()) {
-          runs.open_loop_s[f].push_back(table.rows.back()[c]);
+      double longest_period_s = 0.0;
+      bool has_period = false;  // runs from before the column have none
+      for (const rundir::TrajectoryRow& row : trajectory) {
+        const rundir::FilterRow& filter = row.filters[f];
+        total_us += filter.processing_us;
+        if (!std::isnan(filter.period_s)) {
+          longest_period_s = std::max(longest_period_s, filter.period_s);
+          has_period = true;
         }
-        if (table.columns[c] != names[f] + "_period") continue;
-        double longest = 0.0;
-        for (const std::vector<double>& row : table.rows) longest = std::max(longest, row[c]);
-        runs.max_period_s[f].push_back(longest);
+      }
+      runs.processing_s[f].push_back(total_us * 1e-6);
+      if (has_period) runs.max_period_s[f].push_back(longest_period_s);
+      // Open loop: the run's accumulated f_open_loop at its last step.
+      if (!trajectory.empty() && !std::isnan(trajectory.back().filters[f].open_loop_s)) {
+        runs.open_loop_s[f].push_back(trajectory.back().filters[f].open_loop_s);
       }
     }
     runs.summaries.push_back(ReadJsonFile(PathIn(run_dir, rundir::kSummaryFile), nlohmann::json::object()));

@@ -27,7 +27,6 @@
 namespace mjslam::app {
 namespace {
 
-using rundir::CsvTable;
 
 nlohmann::json Xyz(const Eigen::Vector3d& v) {
   return {{"x", v(0)}, {"y", v(1)}, {"th", v(2)}};
@@ -139,39 +138,31 @@ eval::Map RunGroundTruth(const std::string& run_dir, const eval::GroundTruthPara
                           config.sim.max_world_extent_m);
 }
 
-std::vector<eval::PoseStepMetrics> PoseSteps(const CsvTable& trajectory, const std::string& name) {
-  const int truth = trajectory.ColumnIndex("true_x");
-  const int estimate = trajectory.ColumnIndex(name + "_x");
-  const int pxx = trajectory.ColumnIndex(name + "_pxx");
+std::vector<eval::PoseStepMetrics> PoseSteps(const std::vector<rundir::TrajectoryRow>& trajectory,
+                                             std::size_t filter) {
   // Realtime timing: a row whose scan the filter skipped holds the estimate
   // of its last processed row, compared with that row's truth.
-  const auto& columns = trajectory.columns;
-  const bool has_processed =
-      std::find(columns.begin(), columns.end(), name + "_processed") != columns.end();
-  const int processed = has_processed ? trajectory.ColumnIndex(name + "_processed") : -1;
   std::vector<eval::PoseStepMetrics> steps;
   Pose2 X_WR_true;
-  for (const std::vector<double>& row : trajectory.rows) {
-    if (processed < 0 || row[processed] != 0.0 || steps.empty()) {
-      X_WR_true = Pose2(row[truth], row[truth + 1], row[truth + 2]);
-    }
-    Eigen::Matrix3d P;
-    P << row[pxx], row[pxx + 1], row[pxx + 2], row[pxx + 1], row[pxx + 3], row[pxx + 4],
-        row[pxx + 2], row[pxx + 4], row[pxx + 5];
-    steps.push_back(eval::EvaluatePoseStep(
-        X_WR_true, Pose2(row[estimate], row[estimate + 1], row[estimate + 2]), P));
+  for (const rundir::TrajectoryRow& row : trajectory) {
+    const rundir::FilterRow& f = row.filters.at(filter);
+    if (f.processed || steps.empty()) X_WR_true = row.X_WR_true;
+    steps.push_back(eval::EvaluatePoseStep(X_WR_true, f.X_WR, f.P));
   }
   return steps;
 }
 
-std::vector<double> PoseNees(const CsvTable& trajectory, const std::string& name) {
+std::vector<double> PoseNees(const std::vector<rundir::TrajectoryRow>& trajectory,
+                             std::size_t filter) {
   std::vector<double> nees;
-  for (std::size_t c = 0; c < trajectory.columns.size(); ++c) {
-    if (trajectory.columns[c] != name + "_nees") continue;
-    for (const std::vector<double>& row : trajectory.rows) nees.push_back(row[c]);
-    return nees;
+  bool written = false;  // a run from before the column has none
+  for (const rundir::TrajectoryRow& row : trajectory) {
+    nees.push_back(row.filters.at(filter).nees);
+    written = written || !std::isnan(nees.back());
   }
-  for (const eval::PoseStepMetrics& m : PoseSteps(trajectory, name)) nees.push_back(m.nees);
+  if (written) return nees;
+  nees.clear();
+  for (const eval::PoseStepMetrics& m : PoseSteps(trajectory, filter)) nees.push_back(m.nees);
   return nees;
 }
 
@@ -186,19 +177,20 @@ RunEvaluation EvaluateRunDirectory(const std::string& run_dir, const EvaluateOpt
   const rundir::RunDirectoryLock lock(run_dir);
   CpuLaps laps;
   laps.Start();
-  const CsvTable trajectory =
-      rundir::ReadTrajectoryCsv(rundir::PathIn(run_dir, rundir::kTrajectoryFile));
+  const std::string trajectory_path = rundir::PathIn(run_dir, rundir::kTrajectoryFile);
+  const std::vector<rundir::TrajectoryRow> trajectory =
+      rundir::ReadTrajectoryRows(trajectory_path);
   laps.Charge(&result.cpu.trajectory_s);
   // A recording without truth (a real log) has no world to compare with.
-  if (std::isnan(trajectory.rows[0][1])) {
-    throw std::runtime_error(trajectory.path + ": true_x is nan: no true pose to evaluate against "
+  if (std::isnan(trajectory.at(0).X_WR_true.x)) {
+    throw std::runtime_error(trajectory_path + ": true_x is nan: no true pose to evaluate against "
                              "(a real log: evaluate the directory mjslam import wrote)");
   }
+  for (const rundir::FilterRow& f : trajectory[0].filters) result.names.push_back(f.name);
   // A --pair the run has not: an error before anything is written.
   if (!options.divergence_pair.empty()) {
-    ChooseDivergencePair(
-        rundir::TrajectoryFilterNames(trajectory.columns), [](std::size_t) { return true; },
-        options.divergence_pair, trajectory.path);
+    ChooseDivergencePair(result.names, [](std::size_t) { return true; }, options.divergence_pair,
+                         trajectory_path);
   }
   result.truth = RunGroundTruth(run_dir, options.ground_truth);
   rundir::WriteMapCsv(rundir::PathIn(run_dir, rundir::kGroundTruthMapFile), result.truth);
@@ -209,15 +201,15 @@ RunEvaluation EvaluateRunDirectory(const std::string& run_dir, const EvaluateOpt
   laps.Charge(&result.cpu.observations_s);
 
   // Poses and maps of every filter of the trajectory.
-  result.names = rundir::TrajectoryFilterNames(trajectory.columns);
   if (result.names.empty()) {
-    throw std::runtime_error(trajectory.path + ": no filter columns (<name>_x, ...)");
+    throw std::runtime_error(trajectory_path + ": no filter columns (<name>_x, ...)");
   }
   std::vector<eval::Map> maps;
-  for (const std::string& name : result.names) {
+  for (std::size_t i = 0; i < result.names.size(); ++i) {
+    const std::string& name = result.names[i];
     ThrowIfInterrupted("evaluation");
-    std::vector<eval::PoseStepMetrics> steps = PoseSteps(trajectory, name);
-    const std::vector<double> nees = PoseNees(trajectory, name);
+    std::vector<eval::PoseStepMetrics> steps = PoseSteps(trajectory, i);
+    const std::vector<double> nees = PoseNees(trajectory, i);
     for (std::size_t k = 0; k < steps.size(); ++k) steps[k].nees = nees[k];
     result.pose.push_back(eval::SummarisePoseSteps(steps));
     laps.Charge(&result.cpu.poses_s);
@@ -228,7 +220,7 @@ RunEvaluation EvaluateRunDirectory(const std::string& run_dir, const EvaluateOpt
   if (options.divergence_points > 0) {
     const std::optional<eval::DivergencePair> pair = ChooseDivergencePair(
         result.names, [&maps](std::size_t i) { return eval::HasDivergenceMass(maps[i]); },
-        options.divergence_pair, trajectory.path, &result.no_divergence);
+        options.divergence_pair, trajectory_path, &result.no_divergence);
     if (pair) {
       const std::uint64_t seed = manifest.value("seed", std::uint64_t{0});
       const std::vector<eval::DivergenceStatistics> rows = StudyRunMaps(

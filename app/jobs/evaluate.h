@@ -8,7 +8,7 @@
 
 #include <nlohmann/json.hpp>
 
-#include "rundir/csv_reader.h"
+#include "rundir/rows.h"
 #include "eval/ground_truth.h"
 #include "eval/map_divergence.h"
 #include "eval/map_matching.h"
@@ -102,19 +102,20 @@ std::optional<eval::DivergencePair> ChooseDivergencePair(
     const std::vector<std::string>& requested, const std::string& where,
     std::string* why_not = nullptr);
 
-/// The pose metrics (error, NEES, inside 2 sigma) of filter `name` at every
-/// row of a trajectory.csv table, from its estimate, covariance and truth
-/// columns. A row whose scan the filter skipped (realtime timing,
-/// `<name>_processed` 0) holds the estimate of its last processed row and is
-/// compared with that row's true pose.
-std::vector<eval::PoseStepMetrics> PoseSteps(const rundir::CsvTable& trajectory,
-                                             const std::string& name);
+/// The pose metrics (error, NEES, inside 2 sigma) of the trajectory's
+/// filter `filter` (its index in TrajectoryRow::filters) at every row. A row
+/// whose scan the filter skipped (realtime timing, processed false) holds the
+/// estimate of its last processed row and is compared with that row's true
+/// pose.
+std::vector<eval::PoseStepMetrics> PoseSteps(const std::vector<rundir::TrajectoryRow>& trajectory,
+                                             std::size_t filter);
 
-/// The pose NEES (3 dof) of filter `name` at every row of a trajectory.csv
-/// table: its `<name>_nees` column when present, else computed from the
-/// estimate, the truth and the covariance columns (NaN where the covariance
-/// is not positive definite, e.g. the known start).
-std::vector<double> PoseNees(const rundir::CsvTable& trajectory, const std::string& name);
+/// The pose NEES (3 dof) of the trajectory's filter `filter` at every row:
+/// its `<name>_nees` column, or, in a run from before that column (all
+/// NaN), computed from the estimate, the truth and the covariance (NaN
+/// where the covariance is not positive definite, e.g. the known start).
+std::vector<double> PoseNees(const std::vector<rundir::TrajectoryRow>& trajectory,
+                             std::size_t filter);
 
 /// Evaluates a finished run directory: builds the ground truth
 /// (RunGroundTruth) and writes it to ground_truth_map.csv, compares both

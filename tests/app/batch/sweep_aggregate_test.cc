@@ -29,19 +29,28 @@ std::string FreshDir(const std::string& name) {
 }
 
 // A trajectory.csv with the given NEES per step for both filters (columns
-// f_nees; f_x names the filter), 100 us per step and, when `with_period`,
-// f_period and f_open_loop columns.
+// f_nees), the truth and both estimates at the origin with a unit covariance,
+// 100 and 50 us per step and, when `with_period`, f_period and f_open_loop
+// columns (runs from before them have none).
 void WriteRun(const std::string& dir, const std::vector<double>& classical_nees,
               const std::vector<double>& selective_nees, bool with_period) {
   fs::create_directories(dir);
   std::ofstream out(rundir::PathIn(dir, rundir::kTrajectoryFile));
-  out << "t,classical_x,classical_us,classical_nees,selective_x,selective_us,selective_nees";
+  out << "t,true_x,true_y,true_th,odom_x,odom_y,odom_th,cmd_v,cmd_w";
+  for (const char* f : {"classical", "selective"}) {
+    for (const char* suffix : {"x", "y", "th", "pxx", "pxy", "pxth", "pyy", "pyth", "pthth",
+                               "nfeat", "nmatched", "nupdated", "us", "nees"}) {
+      out << "," << f << "_" << suffix;
+    }
+  }
   if (with_period) {
     out << ",classical_period,selective_period,classical_open_loop,selective_open_loop";
   }
   out << "\n";
   for (std::size_t k = 0; k < classical_nees.size(); ++k) {
-    out << 0.1 * k << ",0,100," << classical_nees[k] << ",0,50," << selective_nees[k];
+    out << 0.1 * k << ",0,0,0,0,0,0,0,0";
+    out << ",0,0,0,1,0,0,1,0,1,0,0,0,100," << classical_nees[k];
+    out << ",0,0,0,1,0,0,1,0,1,0,0,0,50," << selective_nees[k];
     // The classical filter holds its command 0.3 s at step 2 (0.2 s open
     // loop from then on), else 0.1 s.
     if (with_period) out << "," << (k == 2 ? 0.3 : 0.1) << ",0.1," << (k >= 2 ? 0.2 : 0.0) << ",0";
