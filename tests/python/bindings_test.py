@@ -270,3 +270,22 @@ def test_the_notebook_example_runs(tmp_path):
     assert (tmp_path / "errors.png").stat().st_size > 10000
     assert mjslam.read_run(str(tmp_path / "run")).filter_names == (
         "classical", "selective", "dead_reckoning")
+
+
+def test_the_cost_scripts_print_their_figures():
+    # scripts/python_step_overhead.py and scripts/filter_bank_cost.py on short runs: each line of
+    # figures is there and its numbers are positive.
+    env = dict(os.environ, PYTHONPATH=os.path.dirname(os.path.dirname(mjslam.__file__)))
+    overhead = subprocess.run(
+        [sys.executable, os.path.join(SOURCE_DIR, "scripts", "python_step_overhead.py"),
+         "--duration", "3", "--repeats", "1", "--config", DEFAULT], env=env, capture_output=True,
+        text=True)
+    assert overhead.returncode == 0, overhead.stderr[-3000:]
+    lines = [line for line in overhead.stdout.splitlines() if " us " in line]
+    assert len(lines) == 3 and all(float(line.split()[-2]) > 0 for line in lines), overhead.stdout
+    cost = subprocess.run(
+        [sys.executable, os.path.join(SOURCE_DIR, "scripts", "filter_bank_cost.py"),
+         "--duration", "3", "--repeats", "1"], env=env, capture_output=True, text=True)
+    assert cost.returncode == 0, cost.stderr[-3000:]
+    ratio = [line for line in cost.stdout.splitlines() if "together / sum alone" in line]
+    assert len(ratio) == 1 and 0 < float(ratio[0].split()[-1]) < 2, cost.stdout
