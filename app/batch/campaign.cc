@@ -68,11 +68,26 @@ std::vector<ParamProblem> CampaignAxis::Validate() const {
   return check.problems();
 }
 
+std::vector<ParamProblem> CampaignCondition::Validate() const {
+  ParamChecker check;
+  check.Require(!name.empty() && name == FolderSafe(name), "name", name,
+                "letters, digits, '_', '-', '+' or '.', not starting with '.'");
+  for (std::size_t i = 0; i < set.size(); ++i) {
+    const std::size_t equals = set[i].find('=');
+    check.Require(equals != std::string::npos && equals > 0,
+                  "set[" + std::to_string(i) + "]", set[i], "KEY=VALUE");
+  }
+  return check.problems();
+}
+
 std::vector<ParamProblem> CampaignParams::Validate() const {
   ParamChecker check;
   check.NonNegative("runs", runs);
   for (std::size_t i = 0; i < axes.size(); ++i) {
     check.Merge("axes[" + std::to_string(i) + "]", axes[i].Validate());
+  }
+  for (std::size_t i = 0; i < conditions.size(); ++i) {
+    check.Merge("conditions[" + std::to_string(i) + "]", conditions[i].Validate());
   }
   return check.problems();
 }
@@ -82,6 +97,16 @@ CampaignParams LoadCampaign(const std::string& path) {
   const fs::path folder = fs::absolute(path).parent_path();
   for (std::string& world : campaign.worlds) {
     world = (folder / world).lexically_normal().string();
+  }
+  // A condition's world or robot, like `worlds`, relative to the file.
+  for (CampaignCondition& condition : campaign.conditions) {
+    for (std::string& override : condition.set) {
+      for (const std::string key : {"run.world=", "run.robot_model="}) {
+        if (override.rfind(key, 0) == 0) {
+          override = key + (folder / override.substr(key.size())).lexically_normal().string();
+        }
+      }
+    }
   }
   return campaign;
 }
@@ -119,6 +144,7 @@ std::size_t CampaignCellCount(const CampaignParams& campaign, std::size_t limit)
     if (count > limit) break;
     count *= axis.values.size();  // at most limit x 2^32: no overflow in 64 bits
   }
+  if (count <= limit && !campaign.conditions.empty()) count *= campaign.conditions.size();
   return std::min(count, limit + 1);
 }
 
@@ -164,13 +190,27 @@ std::vector<CampaignCell> CampaignCells(const CampaignParams& campaign) {
     }
     cells = product;
   }
+  if (!campaign.conditions.empty()) {
+    std::vector<CampaignCell> product;
+    for (const CampaignCell& cell : cells) {
+      for (const CampaignCondition& condition : campaign.conditions) {
+        CampaignCell next = cell;
+        const std::string part = FolderSafe(condition.name);
+        next.name = next.name.empty() ? part : next.name + "__" + part;
+        next.overrides.insert(next.overrides.end(), condition.set.begin(), condition.set.end());
+        next.labels.emplace_back("condition", condition.name);
+        product.push_back(next);
+      }
+    }
+    cells = product;
+  }
   // Two cells in one folder would mix their runs.
   std::set<std::string> names;
   for (CampaignCell& cell : cells) {
     if (cell.name.empty()) cell.name = "all";
     if (!names.insert(cell.name).second) {
       throw std::runtime_error("campaign: two cells would share the folder '" + cell.name +
-                               "' (a world or value given twice?)");
+                               "' (a world, value or condition given twice?)");
     }
   }
   return cells;

@@ -30,6 +30,23 @@ struct CampaignAxis {
   std::vector<ParamProblem> Validate() const;
 };
 
+/// A named condition: overrides (as --set) that together make one case, e.g.
+/// {name: bias_plus_15mm, set: [laser.range_bias_m=0.015, laser.range_bias_std_m=0]}.
+struct CampaignCondition {
+  /// The cell's label and part of its folder name: letters, digits, '_',
+  /// '-', '+', '.'.
+  std::string name;
+  /// KEY=VALUE overrides; none: the config as it is.
+  std::vector<std::string> set;
+
+  template <typename Archive>
+  void Serialize(Archive* a) {
+    a->Visit(MJSLAM_NVP(name));
+    a->Visit(MJSLAM_NVP(set));
+  }
+  std::vector<ParamProblem> Validate() const;
+};
+
 /// A campaign file:
 ///
 ///     runs: 40                  # seeds run.seed + 0 .. runs - 1 in every cell
@@ -37,8 +54,12 @@ struct CampaignAxis {
 ///     axes:
 ///       - key: slam.ekf.max_updates
 ///         values: [1, 2, 3]
+///     conditions:               # one at a time, not a product of keys
+///       - {name: nominal}
+///       - {name: bias, set: [laser.range_bias_m=0.015]}
 ///
-/// World paths are relative to the file's folder.
+/// World paths (in `worlds`, and run.world / run.robot_model in a
+/// condition's `set`) are relative to the file's folder.
 struct CampaignParams {
   /// Runs per cell; 0: --runs decides.
   int runs = 0;
@@ -46,12 +67,15 @@ struct CampaignParams {
   std::vector<std::string> worlds;
   /// Config keys and their values; the grid is their product with worlds.
   std::vector<CampaignAxis> axes;
+  /// Named conditions, an axis of its own after `axes`; empty: none.
+  std::vector<CampaignCondition> conditions;
 
   template <typename Archive>
   void Serialize(Archive* a) {
     a->Visit(MJSLAM_NVP(runs));
     a->Visit(MJSLAM_NVP(worlds));
     a->Visit(MJSLAM_NVP(axes));
+    a->Visit(MJSLAM_NVP(conditions));
   }
   std::vector<ParamProblem> Validate() const;
 };
@@ -81,7 +105,8 @@ CampaignParams LoadCampaign(const std::string& path);
 CampaignParams CampaignFromOptions(const std::vector<std::string>& worlds,
                                    const std::vector<std::string>& vary);
 
-/// The number of cells of the grid (worlds x the values of each axis),
+/// The number of cells of the grid (worlds x the values of each axis x the
+/// conditions),
 /// counted without making them; `limit` + 1 when there are more than
 /// `limit`.
 std::size_t CampaignCellCount(const CampaignParams& campaign, std::size_t limit);
@@ -90,8 +115,8 @@ std::size_t CampaignCellCount(const CampaignParams& campaign, std::size_t limit)
 /// same (the same text, or the same number: 10, 10.0, 1e1).
 void CheckDistinctValues(const CampaignParams& campaign);
 
-/// The cells of the grid, worlds outermost, then the axes in order (the last
-/// varies fastest). Throws std::runtime_error when two cells get one name or
+/// The cells of the grid, worlds outermost, then the axes in order, then the
+/// conditions (the last varies fastest). Throws std::runtime_error when two cells get one name or
 /// an axis repeats a value (CheckDistinctValues).
 std::vector<CampaignCell> CampaignCells(const CampaignParams& campaign);
 

@@ -37,6 +37,49 @@ TEST(CampaignTest, CellsAreWorldsTimesEachAxisLastAxisFastest) {
   EXPECT_EQ(cells[3].labels.front(), (std::pair<std::string, std::string>{"world", "office"}));
 }
 
+TEST(CampaignTest, ConditionsAreAnAxisOfNamedOverrideSets) {
+  CampaignParams campaign;
+  campaign.worlds = {"/w/room.xml"};
+  campaign.axes = {{"slam.ekf.max_updates", {"1", "2"}}};
+  campaign.conditions = {{"nominal", {}},
+                         {"bias+15mm", {"laser.range_bias_m=0.015", "laser.range_bias_std_m=0"}}};
+  EXPECT_EQ(CampaignCellCount(campaign, 100), 4u);
+  const std::vector<CampaignCell> cells = CampaignCells(campaign);
+  ASSERT_EQ(cells.size(), 4u);
+  EXPECT_EQ(cells[0].name, "room__slam.ekf.max_updates=1__nominal");
+  EXPECT_EQ(cells[1].name, "room__slam.ekf.max_updates=1__bias+15mm");
+  EXPECT_EQ(cells[1].overrides,
+            (std::vector<std::string>{"run.world=/w/room.xml", "slam.ekf.max_updates=1",
+                                      "laser.range_bias_m=0.015", "laser.range_bias_std_m=0"}));
+  EXPECT_EQ(cells[3].labels.back(),
+            (std::pair<std::string, std::string>{"condition", "bias+15mm"}));
+  campaign.conditions.push_back({"nominal", {"a.b=1"}});
+  EXPECT_THROW(CampaignCells(campaign), std::runtime_error);  // two folders named nominal
+}
+
+TEST(CampaignTest, ConditionsInAFileTakeWorldsRelativeToItAndBadOnesAreNamed) {
+  const std::string path = WriteCampaign(
+      "conditions.yaml",
+      "conditions:\n  - {name: nominal}\n  - {name: pillars, set: [run.world=w/pillars.xml, "
+      "sim.drive_disturbance_std_fraction=0.02]}\n");
+  const CampaignParams campaign = LoadCampaign(path);
+  ASSERT_EQ(campaign.conditions.size(), 2u);
+  EXPECT_TRUE(campaign.conditions[0].set.empty());
+  EXPECT_EQ(campaign.conditions[1].set[0],
+            "run.world=" + (fs::path(path).parent_path() / "w/pillars.xml").string());
+  EXPECT_EQ(campaign.conditions[1].set[1], "sim.drive_disturbance_std_fraction=0.02");
+  for (const char* bad : {"conditions:\n  - {name: 'a b'}\n",
+                          "conditions:\n  - {name: ok, set: [no_equals]}\n"}) {
+    try {
+      LoadCampaign(WriteCampaign("bad_condition.yaml", bad));
+      ADD_FAILURE() << bad;
+    } catch (const config::ConfigError& error) {
+      EXPECT_NE(std::string(error.what()).find("conditions[0]"), std::string::npos)
+          << error.what();
+    }
+  }
+}
+
 TEST(CampaignTest, WithoutWorldsTheConfigsWorldIsKept) {
   CampaignParams campaign;
   campaign.axes = {{"slam.ekf.max_updates", {"1", "3"}}};
