@@ -185,7 +185,14 @@ class PythonFilter : public slam::Filter {
     const py::object features = filter_.attr("map")();
     int index = 0;
     for (const py::handle item : features) {
-      const py::dict d = py::reinterpret_borrow<py::dict>(item);
+      if (!py::isinstance<py::dict>(item) || !item.cast<py::dict>().contains("type") ||
+          !item.cast<py::dict>().contains("params") ||
+          !item.cast<py::dict>().contains("covariance")) {
+        throw std::runtime_error(where_ + ": map() feature " + std::to_string(index) + " is " +
+                                 py::repr(item).cast<std::string>() +
+                                 ", expected a dict with type, params and covariance");
+      }
+      const py::dict d = item.cast<py::dict>();
       MapFeature f;
       f.id = d.contains("id") ? d["id"].cast<int>() : index;
       const std::string type = d["type"].cast<std::string>();

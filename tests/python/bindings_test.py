@@ -215,6 +215,11 @@ class Failing(Recorder):
         return None
 
 
+class BadMap(Recorder):
+    def map(self):
+        return [(1.0, 2.0)]
+
+
 class UnknownField(Recorder):
     def step(self, record, features):
         return {"num_matches": 1}
@@ -242,6 +247,13 @@ def test_bad_input_names_what_is_wrong(tmp_path):
         loop.step()
     with pytest.raises(KeyError, match="no filter 'nope'.*classical, u"):
         loop.pose("nope")
+    mjslam.register_filter("test_bad_map", BadMap)
+    loop = mjslam.Loop(DEFAULT, SHORT + filters(("classical", "ekf", "classical"),
+                                                ("m", "test_bad_map")))
+    loop.step()
+    with pytest.raises(RuntimeError, match="filter 'm' \\(kind test_bad_map\\): map\\(\\) feature 0 "
+                                           "is \\(1.0, 2.0\\), expected a dict"):
+        loop.map("m")
     # A filter's own exception reaches the caller as it was raised; the run directory keeps
     # every complete row and its manifest says the run failed.
     mjslam.register_filter("test_failing", Failing)
