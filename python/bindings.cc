@@ -308,7 +308,8 @@ std::map<std::string, py::object>& PythonKinds() {
 
 void RegisterFilter(const std::string& kind, py::object filter_class) {
   if (!PyCallable_Check(filter_class.ptr())) {
-    throw py::type_error("register_filter('" + kind + "', ...): expected a class or callable, got " +
+    throw py::type_error("register_filter('" + kind +
+                         "', ...): expected a class or callable, got " +
                          py::repr(filter_class).cast<std::string>());
   }
   slam::FilterRegistry& registry = slam::FilterRegistry::Global();
@@ -413,7 +414,9 @@ class Loop {
     const int i = loop_->filters().IndexOf(name);
     if (i < 0) {
       std::string names;
-      for (const std::string& n : loop_->filters().names()) names += (names.empty() ? "" : ", ") + n;
+      for (const std::string& n : loop_->filters().names()) {
+        names += (names.empty() ? "" : ", ") + n;
+      }
       throw py::key_error("no filter '" + name + "' in this loop (its filters: " + names + ")");
     }
     return i;
@@ -603,9 +606,12 @@ PYBIND11_MODULE(_mjslam, m) {
       .def_property_readonly("index", [](const Step& s) { return s.step.index; })
       .def_property_readonly("t", [](const Step& s) { return s.step.record.t_s; })
       .def_property_readonly("record", [](const Step& s) { return Record{s.step.record}; })
-      .def_property_readonly("true_pose", [](const Step& s) { return AsVector(s.step.row.X_WR_true); })
-      .def_property_readonly("true_laser_pose", [](const Step& s) { return AsVector(s.step.X_WS_true); })
-      .def_property_readonly("odometry", [](const Step& s) { return AsVector(s.step.row.X_WR_odometry); })
+      .def_property_readonly("true_pose",
+                             [](const Step& s) { return AsVector(s.step.row.X_WR_true); })
+      .def_property_readonly("true_laser_pose",
+                             [](const Step& s) { return AsVector(s.step.X_WS_true); })
+      .def_property_readonly("odometry",
+                             [](const Step& s) { return AsVector(s.step.row.X_WR_odometry); })
       .def_property_readonly("command", [](const Step& s) {
         return Eigen::Vector2d(s.step.row.command.v_mps, s.step.row.command.w_radps);
       })

@@ -251,8 +251,8 @@ def test_bad_input_names_what_is_wrong(tmp_path):
     loop = mjslam.Loop(DEFAULT, SHORT + filters(("classical", "ekf", "classical"),
                                                 ("m", "test_bad_map")))
     loop.step()
-    with pytest.raises(RuntimeError, match="filter 'm' \\(kind test_bad_map\\): map\\(\\) feature 0 "
-                                           "is \\(1.0, 2.0\\), expected a dict"):
+    with pytest.raises(RuntimeError, match="filter 'm' \\(kind test_bad_map\\): map\\(\\) "
+                                           "feature 0 is \\(1.0, 2.0\\), expected a dict"):
         loop.map("m")
     # A filter's own exception reaches the caller as it was raised; the run directory keeps
     # every complete row and its manifest says the run failed.
