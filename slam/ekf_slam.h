@@ -59,6 +59,10 @@ struct StepReport {
   /// them), each against its feature in the predicted state, before any
   /// correction: the input of InnovationCheck.
   double nis_sum = 0.0;
+  /// The corrections' cost for ControlParams' cost model: the sum over the
+  /// step's corrections of n^2, n the size of the state each one updated.
+  /// Negative (EkfSlam): num_updated (3 + 2 num_features)^2.
+  double correction_cost_n2 = -1.0;
   /// What became of each observation (lines first, then corners, as the
   /// features were extracted), for diagnostics: its outcome and matched
   /// feature (an index into the map before this step's duplicate lines were
@@ -125,6 +129,17 @@ class EkfSlam {
   const SlamState& slam_state() const { return state_; }
   /// The mode this filter was built with.
   CorrectionMode mode() const { return mode_; }
+  /// SlamState::StartCalibrationFrom on this filter's state (with
+  /// self-calibration, before any feature).
+  void StartCalibrationFrom(const Eigen::VectorXd& mean, const Eigen::MatrixXd& covariance) {
+    state_.StartCalibrationFrom(mean, covariance);
+  }
+  /// Line feature k: the side of the line (in its state form) the sensor
+  /// saw it from, the sign of r - p_WS . (cos al, sin al) (+1 or -1); 0 for
+  /// corners.
+  int seen_side(int k) const { return info_[k].seen_side; }
+  /// Feature k's seen segment along its line (lines only).
+  const LineSegment& segment(int k) const { return info_[k].segment; }
 
  private:
   // One observation of a scan, as the filter uses it.

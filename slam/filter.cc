@@ -7,6 +7,7 @@
 
 #include "common/check.h"
 #include "slam/ekf_filter.h"
+#include "slam/submap_filter.h"
 
 namespace mjslam::slam {
 namespace {
@@ -30,6 +31,15 @@ std::vector<std::string> Names(const char* const* begin, const char* const* end)
 std::vector<ParamProblem> ValidateEkfFilter(const FilterParams& filter) {
   ParamChecker check;
   check.OneOf("update", filter.update, {"classical", "selective"});
+  return check.problems();
+}
+
+// Kind submaps: its update rule and submap size.
+std::vector<ParamProblem> ValidateSubmapFilter(const FilterParams& filter) {
+  ParamChecker check;
+  check.OneOf("update", filter.update, {"classical", "selective"});
+  check.Require(filter.submap_max_features >= 1, "submap_max_features",
+                filter.submap_max_features, "a value >= 1");
   return check.problems();
 }
 
@@ -125,7 +135,7 @@ std::vector<std::string> FilterNamesOf(const SlamParams& slam) {
 
 FilterRegistry& FilterRegistry::Global() {
   // Built on first use (also from another object's static registration), with
-  // the built-in kind.
+  // the built-in kinds.
   static FilterRegistry* registry = [] {
     auto* r = new FilterRegistry();
     r->Register(
@@ -134,6 +144,12 @@ FilterRegistry& FilterRegistry::Global() {
           return std::make_unique<EkfFilter>(settings, X_WR0, X_RS, std::move(rng));
         },
         ValidateEkfFilter);
+    r->Register(
+        "submaps",
+        [](const FilterSettings& settings, const Pose2& X_WR0, const Pose2& X_RS, Rng rng) {
+          return std::make_unique<SubmapFilter>(settings, X_WR0, X_RS, std::move(rng));
+        },
+        ValidateSubmapFilter);
     return r;
   }();
   return *registry;

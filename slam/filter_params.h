@@ -16,10 +16,12 @@ struct FilterParams {
   /// control.pose_source: lower-case letters, digits and '_', starting with
   /// a letter; not odometry or ground_truth.
   std::string name;
-  /// The registered kind (FilterRegistry): "ekf" (EKF-SLAM, EkfSlam) or a
-  /// kind another library registers (examples/).
+  /// The registered kind (FilterRegistry): "ekf" (EKF-SLAM, EkfSlam),
+  /// "submaps" (EKF-SLAM in submaps joined into a global map, SubmapFilter)
+  /// or a kind another library registers (examples/).
   std::string kind = "ekf";
-  /// Kind ekf: "classical" (Algorithm 1) or "selective" (Algorithm 2).
+  /// Kinds ekf and submaps: "classical" (Algorithm 1) or "selective"
+  /// (Algorithm 2).
   std::string update;
   /// MAX of Algorithm 2; 0: slam.ekf.max_updates.
   int max_updates = 0;
@@ -31,6 +33,9 @@ struct FilterParams {
   /// Scales every standard deviation of slam.ekf.process_model.noise (of
   /// either kind) for this filter (> 0; 1: slam.ekf's noise as it is).
   double process_noise_scale = 1.0;
+  /// Kind submaps: a submap is closed and joined into the global map when
+  /// it holds this many features (>= 1).
+  int submap_max_features = 60;
 
   template <typename Archive>
   void Serialize(Archive* a) {
@@ -41,6 +46,7 @@ struct FilterParams {
     a->Visit(MJSLAM_NVP(selection_policy));
     a->Visit(MJSLAM_NVP(timing));
     a->Visit(MJSLAM_NVP(process_noise_scale));
+    a->Visit(MJSLAM_NVP(submap_max_features));
   }
   /// The problems of this entry alone (keys relative to it): the name's
   /// form, a registered kind, kind ekf's update, the ranges.

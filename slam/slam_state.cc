@@ -45,6 +45,30 @@ SlamState::SlamState(const Eigen::Vector3d& pose_WR, const Eigen::Matrix3d& pose
   scratch_ = Eigen::MatrixXd::Zero(capacity, 2);
 }
 
+void SlamState::StartCalibrationFrom(const Eigen::VectorXd& mean,
+                                     const Eigen::MatrixXd& covariance) {
+  MJSLAM_CHECK(calibrated() && num_features() == 0 && shared_size_ == 0);
+  MJSLAM_CHECK(mean.size() == kCalibrationSize && covariance.rows() == kCalibrationSize &&
+               covariance.cols() == kCalibrationSize);
+  const int c = 3;
+  const int c0 = vehicle_size_;
+  Reserve(vehicle_size_ + kCalibrationSize);
+  shared_size_ = kCalibrationSize;
+  n_ = vehicle_size_ + shared_size_;
+  x_.conservativeResize(n_);
+  x_.segment(c, kCalibrationSize) = mean;
+  x_.segment(c0, kCalibrationSize) = mean;
+  const Eigen::MatrixXd sym = 0.5 * (covariance + covariance.transpose());
+  P_.block(0, c, n_, kCalibrationSize).setZero();
+  P_.block(c, 0, kCalibrationSize, n_).setZero();
+  P_.block(0, c0, n_, kCalibrationSize).setZero();
+  P_.block(c0, 0, kCalibrationSize, n_).setZero();
+  for (const int i : {c, c0}) {
+    for (const int j : {c, c0}) P_.block(i, j, kCalibrationSize, kCalibrationSize) = sym;
+  }
+  if (jacobians_ == JacobianPoint::kFirstEstimates) x_first_ = x_;
+}
+
 Eigen::Matrix2d SlamState::LaserErrorJacobian(const Eigen::Vector2d& z,
                                               const Eigen::Vector2d& range_bias_gradient) {
   // A scale error s moves every point along its beam by s r: a line

@@ -77,7 +77,7 @@ class SlamState {
             const Pose2& X_RS, JacobianPoint jacobians = JacobianPoint::kCurrent,
             const Eigen::VectorXd& calibration_std = Eigen::VectorXd());
 
-  /// n = v + 2 L, v = 3 (+ 5 with self-calibration).
+  /// n = v + 2 L, v = 3 (+ 5 with self-calibration, + 5 with its copy c0).
   int dimension() const { return n_; }
   /// Whether the state holds the five self-calibration entries.
   bool calibrated() const { return vehicle_size_ > 3; }
@@ -88,7 +88,18 @@ class SlamState {
   /// Type of feature k.
   FeatureType feature_type(int k) const { return types_[k]; }
   /// State index of feature k's first component.
-  int FeatureIndex(int k) const { return vehicle_size_ + 2 * k; }
+  int FeatureIndex(int k) const { return vehicle_size_ + shared_size_ + 2 * k; }
+
+  /// With self-calibration and no features yet: the entries (q_d, q_th, k,
+  /// b, s) start from a prior of mean `mean` and covariance `covariance`
+  /// (5 x 5, symmetric PSD, zero on the entries not estimated), uncorrelated
+  /// with the pose; and the state gains a copy c0 of them at
+  /// SharedIndex(), [pose, c, c0, features], that no prediction moves: the
+  /// value the entries had at the start, which corrections estimate through
+  /// its correlations (SubmapFilter's shared part).
+  void StartCalibrationFrom(const Eigen::VectorXd& mean, const Eigen::MatrixXd& covariance);
+  /// State index of c0 (StartCalibrationFrom); -1 without.
+  int SharedIndex() const { return shared_size_ > 0 ? vehicle_size_ : -1; }
 
   /// The mean xi (size n).
   const Eigen::VectorXd& mean() const { return x_; }
@@ -232,6 +243,8 @@ class SlamState {
   Pose2 X_RS_;
   // 3, or 3 + kCalibrationSize with self-calibration.
   int vehicle_size_ = 3;
+  // 0, or kCalibrationSize with the copy c0 (StartCalibrationFrom).
+  int shared_size_ = 0;
   int n_ = 3;
   Eigen::VectorXd x_;
   // Capacity x capacity buffer; P is its top-left n_ x n_ block.

@@ -21,6 +21,9 @@ double ProcessingSeconds(const ControlParams& params, const slam::StepReport& re
                          bool has_scan, double measured_us) {
   if (params.processing == "measured") return measured_us * 1e-6 * params.measured_time_factor;
   if (!has_scan) return 0.0;
+  if (report.correction_cost_n2 >= 0.0) {
+    return params.model_base_s + params.model_s_per_update_per_n2 * report.correction_cost_n2;
+  }
   const double n = 3.0 + 2.0 * report.num_features;
   return params.model_base_s + params.model_s_per_update_per_n2 * report.num_updated * n * n;
 }

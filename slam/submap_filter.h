@@ -1,0 +1,131 @@
+#pragma once
+
+// Kind "submaps" of the FilterRegistry: EKF-SLAM in bounded submaps joined
+// into a global map (docs/method.md, "Submaps").
+#include <memory>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "common/map_feature.h"
+#include "common/pose2.h"
+#include "common/rng.h"
+#include "slam/ekf_slam.h"
+#include "slam/filter.h"
+#include "slam/secondary_map.h"
+
+namespace mjslam::slam {
+
+/// The global map of sequential map joining: the pose of the current
+/// submap's base frame B in W, the self-calibration entries (if any) at the
+/// base, and the features in W, with their full covariance. State
+/// [x_B, y_B, th_B, c, f_1, ..., f_L], feature k at 3 + nc + 2k; lines
+/// (r, al) in canonical form when joined.
+struct JoinedMap {
+  /// nc: 0, or SlamState::kCalibrationSize with self-calibration.
+  int calibration_size = 0;
+  Eigen::VectorXd mean = Eigen::VectorXd::Zero(3);
+  Eigen::MatrixXd covariance = Eigen::MatrixXd::Zero(3, 3);
+  std::vector<FeatureType> types;
+  std::vector<int> ids;
+  /// Lines: the seen segment along the line's current estimate.
+  std::vector<LineSegment> segments;
+  /// Lines: the direction (radians in W) of the line's normal that points
+  /// to the side it was seen from; NaN when not known, and for corners.
+  std::vector<double> facing;
+
+  int num_features() const { return static_cast<int>(types.size()); }
+};
+
+/// What one join did.
+struct JoinReport {
+  /// The submap's features that matched a feature of the global map (and
+  /// were fused with it), and those added as new features.
+  int num_matched = 0;
+  int num_new = 0;
+  /// The joined state's size n when the matches were fused (their cost is
+  /// num_matched n^2 in the cost model).
+  int state_size = 0;
+};
+
+/// Sequential map joining (Tardos, Neira, Newman and Leonard, IJRR 21(4),
+/// 2002) of conditionally independent submaps (Pinies and Tardos, IEEE
+/// T-RO 24(5), 2008): `submap`, an EKF-SLAM whose W is the base frame B of
+/// `map`, started at B with zero covariance and, with self-calibration, from
+/// the map's estimate of it, c0 (SlamState::StartCalibrationFrom), so that
+/// the submap is independent of `map` given c0, is joined into `map`. The
+/// submap's estimate of c0 first updates `map` through its correlations
+/// with c0; the submap's features are carried to W through x_B, its robot
+/// pose becomes the new base and its current self-calibration the map's
+/// (the old base and c0 are marginalised), the covariance propagated to
+/// first order with the cross terms through x_B and c0; then each
+/// submap feature is matched to the global feature nearest in the Mahalanobis
+/// distance of their difference (gate `gate` on chi-square 2 dof, the same
+/// type, a line seen from the same side with seen segments within
+/// `max_segment_gap_m` when > 0; each global feature takes at most one, the
+/// closest pairs first) and the matched pairs are fused by one batch EKF
+/// update with the identity constraint f_submap - f_global = 0, after which
+/// the submap's copy is removed. The submap's self-calibration entries, if
+/// any, are left out (marginalised). New features take ids from *next_id.
+JoinReport JoinSubmap(const EkfSlam& submap, double gate, double max_segment_gap_m,
+                      JoinedMap* map, int* next_id);
+
+/// Kind "submaps": the paper's EKF-SLAM (`update: classical` or
+/// `selective`, as kind ekf) run in a local submap that starts empty at the
+/// robot's pose, closed when it holds `submap_max_features` features and
+/// joined into the global map by JoinSubmap; the next submap starts where
+/// the last ended. Every correction updates the submap's state only, so a
+/// step costs O(submap size^2) whatever the size of the global map; a join
+/// costs O(global size^2) per matched feature.
+class SubmapFilter : public Filter {
+ public:
+  /// `settings.slam.ekf` (the entry's max_updates and selection_policy
+  /// applied) for every submap; the global map starts with x_B = X_WR0 and
+  /// the initial pose covariance of `settings.slam.ekf`. Throws ParamError
+  /// for invalid settings.
+  SubmapFilter(const FilterSettings& settings, const Pose2& X_WR0, const Pose2& X_RS, Rng rng);
+
+  StepReport Step(const SensorRecord& record, const ScanFeatures* features) override;
+  /// X_WB * X_BR: the base's pose in W composed with the submap's estimate.
+  Pose2 X_WR() const override;
+  /// J_B P_B J_B^T + J_R P_R J_R^T (the submap is independent of the base).
+  Eigen::Matrix3d pose_covariance() const override;
+  /// The global map with the current submap joined into it (a copy; the
+  /// filter is unchanged), lines with their seen segments. O(n^2).
+  std::vector<MapFeature> Map() const override;
+  /// Global features plus the current submap's (some of which a join would
+  /// fuse with global ones).
+  int num_features() const override;
+  bool predicts_from_odometry() const override { return odometry_; }
+
+  /// The global map as joined so far (without the current submap).
+  const JoinedMap& global_map() const { return global_; }
+  /// The current submap.
+  const EkfSlam& submap() const { return *submap_; }
+  /// The number of submaps joined so far.
+  int num_joins() const { return num_joins_; }
+
+ private:
+  // A new, empty submap at the base of global_, its self-calibration from
+  // global_'s, primed with `record` as its odometry and command reference
+  // (its first step predicts no motion). Without a record: the first
+  // submap, whose calibration prior global_ takes.
+  void StartSubmap(const SensorRecord* record);
+  // The base x_B given the submap's estimate of the shared calibration,
+  // its covariance, and its covariance with the submap's pose x_BR.
+  void Base(Eigen::Vector3d* x_B, Eigen::Matrix3d* P_B, Eigen::Matrix3d* C_BR) const;
+
+  EkfParams params_;
+  CorrectionMode mode_;
+  Pose2 X_RS_;
+  Rng rng_;
+  bool odometry_;
+  int max_features_;
+  double gate_;
+  JoinedMap global_;
+  std::unique_ptr<EkfSlam> submap_;
+  int num_joins_ = 0;
+  int next_id_ = 0;
+};
+
+}  // namespace mjslam::slam
