@@ -480,6 +480,31 @@ StepReport EkfSlam::Step(const SensorRecord& record, const ScanFeatures* feature
   return report;
 }
 
+std::vector<int> EkfSlam::StartFrom(const Eigen::VectorXd& calibration,
+                                    const std::vector<PriorFeature>& features,
+                                    const Eigen::MatrixXd& covariance) {
+  std::vector<FeatureType> types;
+  Eigen::VectorXd means(2 * features.size());
+  for (std::size_t k = 0; k < features.size(); ++k) {
+    types.push_back(features[k].type);
+    means.segment<2>(2 * k) = features[k].params;
+  }
+  state_.StartFrom(calibration, types, means, covariance);
+  std::vector<int> ids;
+  for (const PriorFeature& feature : features) {
+    ids.push_back(next_id_);
+    info_.push_back({next_id_++, feature.segment, feature.seen_side});
+  }
+  return ids;
+}
+
+int EkfSlam::IndexOfId(int id) const {
+  for (int k = 0; k < num_features(); ++k) {
+    if (info_[k].id == id) return k;
+  }
+  return -1;
+}
+
 std::vector<MapFeature> EkfSlam::Map() const {
   std::vector<MapFeature> map;
   map.reserve(state_.num_features());

@@ -129,11 +129,24 @@ class EkfSlam {
   const SlamState& slam_state() const { return state_; }
   /// The mode this filter was built with.
   CorrectionMode mode() const { return mode_; }
-  /// SlamState::StartCalibrationFrom on this filter's state (with
-  /// self-calibration, before any feature).
-  void StartCalibrationFrom(const Eigen::VectorXd& mean, const Eigen::MatrixXd& covariance) {
-    state_.StartCalibrationFrom(mean, covariance);
-  }
+  /// A feature of a prior map (StartFrom), in W: its type, parameters,
+  /// and for lines the seen segment and side (as seen_side()).
+  struct PriorFeature {
+    FeatureType type = FeatureType::kLine;
+    Eigen::Vector2d params = Eigen::Vector2d::Zero();
+    LineSegment segment;
+    int seen_side = 0;
+  };
+  /// SlamState::StartFrom: before any feature, the filter starts from a
+  /// prior over its self-calibration (if any) and `features`, joint
+  /// covariance `covariance` over [c, features]. Returns the features' ids.
+  std::vector<int> StartFrom(const Eigen::VectorXd& calibration,
+                             const std::vector<PriorFeature>& features,
+                             const Eigen::MatrixXd& covariance);
+  /// Feature k's id, and the index of the feature with id `id` (-1: none,
+  /// e.g. removed as a duplicate line).
+  int id(int k) const { return info_[k].id; }
+  int IndexOfId(int id) const;
   /// Line feature k: the side of the line (in its state form) the sensor
   /// saw it from, the sign of r - p_WS . (cos al, sin al) (+1 or -1); 0 for
   /// corners.

@@ -45,28 +45,39 @@ SlamState::SlamState(const Eigen::Vector3d& pose_WR, const Eigen::Matrix3d& pose
   scratch_ = Eigen::MatrixXd::Zero(capacity, 2);
 }
 
-void SlamState::StartCalibrationFrom(const Eigen::VectorXd& mean,
-                                     const Eigen::MatrixXd& covariance) {
-  MJSLAM_CHECK(calibrated() && num_features() == 0 && shared_size_ == 0);
-  MJSLAM_CHECK(mean.size() == kCalibrationSize && covariance.rows() == kCalibrationSize &&
-               covariance.cols() == kCalibrationSize);
-  const int c = 3;
-  const int c0 = vehicle_size_;
-  Reserve(vehicle_size_ + kCalibrationSize);
-  shared_size_ = kCalibrationSize;
-  n_ = vehicle_size_ + shared_size_;
+void SlamState::StartFrom(const Eigen::VectorXd& calibration,
+                          const std::vector<FeatureType>& types, const Eigen::VectorXd& features,
+                          const Eigen::MatrixXd& covariance) {
+  MJSLAM_CHECK(num_features() == 0 && shared_size_ == 0);
+  const int nc = calibrated() ? kCalibrationSize : 0;
+  const int nf = 2 * static_cast<int>(types.size());
+  MJSLAM_CHECK(calibration.size() == nc && features.size() == nf &&
+               covariance.rows() == nc + nf && covariance.cols() == nc + nf);
+  const int shared = nc;  // the copy c0
+  Reserve(vehicle_size_ + shared + nf);
+  shared_size_ = shared;
+  n_ = vehicle_size_ + shared_size_ + nf;
   x_.conservativeResize(n_);
-  x_.segment(c, kCalibrationSize) = mean;
-  x_.segment(c0, kCalibrationSize) = mean;
+  x_.segment(3, nc) = calibration;
+  x_.segment(vehicle_size_, shared) = calibration;
+  x_.tail(nf) = features;
+  types_ = types;
+  // P over [pose, c, c0, features]: the pose's block stays, uncorrelated
+  // with the rest; c0 is a copy of c.
   const Eigen::MatrixXd sym = 0.5 * (covariance + covariance.transpose());
-  P_.block(0, c, n_, kCalibrationSize).setZero();
-  P_.block(c, 0, kCalibrationSize, n_).setZero();
-  P_.block(0, c0, n_, kCalibrationSize).setZero();
-  P_.block(c0, 0, kCalibrationSize, n_).setZero();
-  for (const int i : {c, c0}) {
-    for (const int j : {c, c0}) P_.block(i, j, kCalibrationSize, kCalibrationSize) = sym;
+  const std::vector<std::pair<int, int>> blocks = {
+      {3, 0}, {vehicle_size_, 0}, {vehicle_size_ + shared, nc}};  // (state index, prior index)
+  const std::vector<int> sizes = {nc, shared, nf};
+  P_.block(0, 3, 3, n_ - 3).setZero();
+  P_.block(3, 0, n_ - 3, 3).setZero();
+  for (int a = 0; a < 3; ++a) {
+    for (int b = 0; b < 3; ++b) {
+      P_.block(blocks[a].first, blocks[b].first, sizes[a], sizes[b]) =
+          sym.block(blocks[a].second, blocks[b].second, sizes[a], sizes[b]);
+    }
   }
   if (jacobians_ == JacobianPoint::kFirstEstimates) x_first_ = x_;
+  WrapAngles();
 }
 
 Eigen::Matrix2d SlamState::LaserErrorJacobian(const Eigen::Vector2d& z,

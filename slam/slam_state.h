@@ -90,15 +90,18 @@ class SlamState {
   /// State index of feature k's first component.
   int FeatureIndex(int k) const { return vehicle_size_ + shared_size_ + 2 * k; }
 
-  /// With self-calibration and no features yet: the entries (q_d, q_th, k,
-  /// b, s) start from a prior of mean `mean` and covariance `covariance`
-  /// (5 x 5, symmetric PSD, zero on the entries not estimated), uncorrelated
-  /// with the pose; and the state gains a copy c0 of them at
-  /// SharedIndex(), [pose, c, c0, features], that no prediction moves: the
-  /// value the entries had at the start, which corrections estimate through
-  /// its correlations (SubmapFilter's shared part).
-  void StartCalibrationFrom(const Eigen::VectorXd& mean, const Eigen::MatrixXd& covariance);
-  /// State index of c0 (StartCalibrationFrom); -1 without.
+  /// A state with no features yet starts from a prior over the
+  /// self-calibration entries c (with self-calibration; else none) and the
+  /// features `types` with means `features` (2 each, in order), with joint
+  /// covariance `covariance` over [c, features] (symmetric PSD, zero on
+  /// entries not estimated); the pose keeps its mean and covariance,
+  /// uncorrelated with them. With self-calibration the state also gains a
+  /// copy c0 of c at SharedIndex(), [pose, c, c0, features], that no
+  /// prediction moves: the value c had at the start, which corrections
+  /// estimate through its correlations (SubmapFilter's shared part).
+  void StartFrom(const Eigen::VectorXd& calibration, const std::vector<FeatureType>& types,
+                 const Eigen::VectorXd& features, const Eigen::MatrixXd& covariance);
+  /// State index of c0 (StartFrom); -1 without.
   int SharedIndex() const { return shared_size_ > 0 ? vehicle_size_ : -1; }
 
   /// The mean xi (size n).
@@ -243,7 +246,7 @@ class SlamState {
   Pose2 X_RS_;
   // 3, or 3 + kCalibrationSize with self-calibration.
   int vehicle_size_ = 3;
-  // 0, or kCalibrationSize with the copy c0 (StartCalibrationFrom).
+  // 0, or kCalibrationSize with the copy c0 (StartFrom).
   int shared_size_ = 0;
   int n_ = 3;
   Eigen::VectorXd x_;

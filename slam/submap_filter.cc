@@ -25,18 +25,19 @@ constexpr double kPi = 3.14159265358979323846;
 // corner made from two lines that match too).
 constexpr double kConstraintVariance = 1e-10;
 
-// The quantities a join carries to W, y = [x_B', c, f_1, ..., f_L] of the
-// submap (c: its nc self-calibration entries as they are now), with their
-// Jacobians by the old base x_B and by the submap's entries
-// [x_BR, c, f_1, ..., f_L].
+// The quantities a join carries to W, y = [x_B', c, f_k...] of the submap
+// (c: its nc self-calibration entries as they are now; f_k its features
+// listed), with their Jacobians by the old base x_B and by the submap's
+// entries [x_BR, c, f_k...].
 struct Transformed {
   Eigen::VectorXd y;
   Eigen::MatrixXd J_base;    // ny x 3
   Eigen::MatrixXd J_submap;  // ny x ny
 };
 
-Transformed ToWorld(const SlamState& s, int nc, const Eigen::Vector3d& base) {
-  const int L = s.num_features();
+Transformed ToWorld(const SlamState& s, int nc, const std::vector<int>& features,
+                    const Eigen::Vector3d& base) {
+  const int L = static_cast<int>(features.size());
   const int ny = 3 + nc + 2 * L;
   Transformed t{Eigen::VectorXd(ny), Eigen::MatrixXd::Zero(ny, 3),
                 Eigen::MatrixXd::Zero(ny, ny)};
@@ -63,8 +64,9 @@ Transformed ToWorld(const SlamState& s, int nc, const Eigen::Vector3d& base) {
     t.y(3 + i) = s.mean()(3 + i);
     t.J_submap(3 + i, 3 + i) = 1.0;
   }
-  for (int k = 0; k < L; ++k) {
-    const int row = 3 + nc + 2 * k;
+  for (int i = 0; i < L; ++i) {
+    const int k = features[i];
+    const int row = 3 + nc + 2 * i;
     const Eigen::Vector2d f = s.feature(k);
     if (s.feature_type(k) == FeatureType::kCorner) {
       point(f, row);
@@ -123,114 +125,190 @@ bool SegmentsMeet(const Eigen::Vector2d& line_a, const LineSegment& seg_a,
 
 }  // namespace
 
+SubmapLink LinkOf(const JoinedMap& map, const std::vector<int>& global_features) {
+  const int nc = map.calibration_size;
+  const int ng = static_cast<int>(map.mean.size());
+  const int nC = nc + 2 * static_cast<int>(global_features.size());
+  SubmapLink link;
+  link.global_features = global_features;
+  link.value.resize(nC);
+  link.G.assign(nC, {});
+  for (int i = 0; i < nc; ++i) {
+    link.value(i) = map.mean(3 + i);
+    link.G[i] = {{3 + i, 1.0}};
+  }
+  const Eigen::Vector3d base = map.mean.head<3>();
+  const double c = std::cos(base(2));
+  const double sn = std::sin(base(2));
+  for (std::size_t j = 0; j < global_features.size(); ++j) {
+    const int g = global_features[j];
+    const int col = 3 + nc + 2 * g;
+    const int row = nc + 2 * static_cast<int>(j);
+    const Eigen::Vector2d f = map.mean.segment<2>(col);
+    if (map.types[g] == FeatureType::kCorner) {
+      // p_B = R^T (p_W - t).
+      const Eigen::Vector2d d = f - base.head<2>();
+      link.value.segment<2>(row) << c * d.x() + sn * d.y(), -sn * d.x() + c * d.y();
+      link.G[row] = {{col, c}, {col + 1, sn}, {0, -c}, {1, -sn}, {2, -sn * d.x() + c * d.y()}};
+      link.G[row + 1] = {
+          {col, -sn}, {col + 1, c}, {0, sn}, {1, -c}, {2, -c * d.x() - sn * d.y()}};
+      continue;
+    }
+    // Line: al_B = al_W - th_B, r_B = r_W - t . n(al_W), then canonical.
+    const double ca = std::cos(f.y());
+    const double sa = std::sin(f.y());
+    Eigen::Matrix2d C;
+    link.value.segment<2>(row) =
+        CanonicalLine(Eigen::Vector2d(f.x() - base(0) * ca - base(1) * sa, f.y() - base(2)), &C);
+    const double k = C(0, 0);  // -1 where the form flipped
+    link.G[row] = {{col, k}, {col + 1, k * (base(0) * sa - base(1) * ca)}, {0, -k * ca},
+                   {1, -k * sa}};
+    link.G[row + 1] = {{col + 1, 1.0}, {2, -1.0}};
+  }
+  // G P and G P G^T.
+  link.GP = Eigen::MatrixXd::Zero(nC, ng);
+  for (int r = 0; r < nC; ++r) {
+    for (const auto& [col, v] : link.G[r]) link.GP.row(r) += v * map.covariance.row(col);
+  }
+  link.P_CC = Eigen::MatrixXd::Zero(nC, nC);
+  for (int r = 0; r < nC; ++r) {
+    for (const auto& [col, v] : link.G[r]) link.P_CC.col(r) += v * link.GP.col(col);
+  }
+  link.P_CC = 0.5 * (link.P_CC + link.P_CC.transpose()).eval();
+  return link;
+}
+
 namespace {
 
-// The shared part of a submap and the global map: the self-calibration's
-// estimated entries (`entries`, of 0..4) at the submap's start, c0. With
-// P_cc and c the global map's covariance and estimate of them, and P0' and
-// c0' the submap's: M = P_cc^-1 P_(c, global), D = P_cc - P0',
-// delta = c0' - c.
+// The shared part C as the submap now knows it, against the link: the
+// rows of C that are estimated (a prior variance > 0, and the feature still
+// in the submap), their state indices in the submap, delta = C' - C and
+// D = P_CC - P'_CC over them.
 struct SharedPart {
-  std::vector<int> entries;
-  Eigen::MatrixXd M;
-  Eigen::MatrixXd D;
+  std::vector<int> rows;
+  std::vector<int> submap_indices;
   Eigen::VectorXd delta;
+  Eigen::MatrixXd D;
+  // P_CC^-1 over the rows, as an LDLT.
+  Eigen::LDLT<Eigen::MatrixXd> P_CC;
+  // M = P_CC^-1 G P over the rows: all of the global map, or its first
+  // three columns (the base).
+  Eigen::MatrixXd M;
 };
 
-SharedPart SharedPartOf(const EkfSlam& submap, const JoinedMap& map) {
+SharedPart SharedPartOf(const EkfSlam& submap, const SubmapLink& link, bool base_only) {
   SharedPart shared;
   const SlamState& s = submap.slam_state();
-  const int nc = map.calibration_size;
-  if (nc == 0) return shared;
-  MJSLAM_CHECK(s.SharedIndex() >= 0);
-  // The estimated entries: those with a prior variance.
-  for (int i = 0; i < nc; ++i) {
-    if (map.covariance(3 + i, 3 + i) > 0.0) shared.entries.push_back(i);
+  const int nC = static_cast<int>(link.value.size());
+  const int nc = nC - 2 * static_cast<int>(link.global_features.size());
+  std::vector<int> index(nC, -1);
+  for (int i = 0; i < nc; ++i) index[i] = s.SharedIndex() + i;
+  for (std::size_t j = 0; j < link.submap_ids.size(); ++j) {
+    const int k = submap.IndexOfId(link.submap_ids[j]);
+    if (k < 0) continue;
+    index[nc + 2 * j] = s.FeatureIndex(k);
+    index[nc + 2 * j + 1] = s.FeatureIndex(k) + 1;
   }
-  const int na = static_cast<int>(shared.entries.size());
-  const int ng = static_cast<int>(map.mean.size());
-  const auto P_sub = s.covariance();
-  Eigen::MatrixXd P_cc(na, na);
-  Eigen::MatrixXd P_cg(na, ng);
-  Eigen::MatrixXd P0_new(na, na);
-  shared.delta.resize(na);
-  for (int i = 0; i < na; ++i) {
-    const int gi = 3 + shared.entries[i];
-    const int si = s.SharedIndex() + shared.entries[i];
-    shared.delta(i) = s.mean()(si) - map.mean(gi);
-    P_cg.row(i) = map.covariance.row(gi);
-    for (int j = 0; j < na; ++j) {
-      P_cc(i, j) = map.covariance(gi, 3 + shared.entries[j]);
-      P0_new(i, j) = P_sub(si, s.SharedIndex() + shared.entries[j]);
+  for (int r = 0; r < nC; ++r) {
+    if (index[r] >= 0 && link.P_CC(r, r) > 0.0) {
+      shared.rows.push_back(r);
+      shared.submap_indices.push_back(index[r]);
     }
   }
-  shared.M = P_cc.ldlt().solve(P_cg);
-  shared.D = P_cc - P0_new;
+  const int na = static_cast<int>(shared.rows.size());
+  if (na == 0) return shared;
+  const auto P_sub = s.covariance();
+  Eigen::MatrixXd P_CC(na, na);
+  Eigen::MatrixXd P_new(na, na);
+  Eigen::MatrixXd GP(na, base_only ? 3 : link.GP.cols());
+  shared.delta.resize(na);
+  for (int i = 0; i < na; ++i) {
+    const int r = shared.rows[i];
+    shared.delta(i) = s.mean()(shared.submap_indices[i]) - link.value(r);
+    // A line's angle (the second row of its pair) wraps.
+    if (r >= nc && (r - nc) % 2 == 1) shared.delta(i) = WrapAngle(shared.delta(i));
+    GP.row(i) = link.GP.row(r).head(GP.cols());
+    for (int j = 0; j < na; ++j) {
+      P_CC(i, j) = link.P_CC(r, shared.rows[j]);
+      P_new(i, j) = P_sub(shared.submap_indices[i], shared.submap_indices[j]);
+    }
+  }
+  shared.D = P_CC - P_new;
+  shared.P_CC.compute(P_CC);
+  shared.M = shared.P_CC.solve(GP);
   return shared;
 }
 
 }  // namespace
 
-JoinReport JoinSubmap(const EkfSlam& submap, double gate, double max_segment_gap_m,
-                      JoinedMap* map, int* next_id) {
+JoinReport JoinSubmap(const EkfSlam& submap, const SubmapLink& link, double gate,
+                      double max_segment_gap_m, JoinedMap* map, int* next_id) {
   const SlamState& s = submap.slam_state();
   const int nc = map->calibration_size;
-  const int L = s.num_features();
   const int Lg = map->num_features();
   const int ng = 3 + nc + 2 * Lg;
   const Eigen::Vector3d base = map->mean.head<3>();
 
-  // 1. The shared calibration: the submap's estimate of the entries' value
-  // at its start, c0, updates the global map through their correlations (the
-  // global map is independent of the submap given c0): x += M^T delta,
-  // P -= M^T D M, and Cov(submap entry, global) = P_(entry, c0) M.
-  const SharedPart shared = SharedPartOf(submap, *map);
+  // 1. The shared part C (the self-calibration at the submap's start, c0,
+  // and the features the submap started with) updates the global map
+  // through its correlations with C: the map is independent of the submap
+  // given C, so x += M^T delta, P -= M^T D M, and Cov(submap entry, map) =
+  // P_(entry, C) M.
+  const SharedPart shared = SharedPartOf(submap, link, false);
+  const int na = static_cast<int>(shared.rows.size());
   Eigen::VectorXd xg = map->mean;
   Eigen::MatrixXd Pg = map->covariance;
-  if (!shared.entries.empty()) {
+  if (na > 0) {
     xg.noalias() += shared.M.transpose() * shared.delta;
     const Eigen::MatrixXd DM = shared.D * shared.M;
     Pg.noalias() -= shared.M.transpose() * DM;
     Pg = 0.5 * (Pg + Pg.transpose()).eval();
   }
 
-  // 2. The submap's entries [x_BR, c, f_1, ..., f_L] (c: the current
-  // self-calibration, if any), their covariance, and their covariance with
-  // c0 (the estimated entries).
+  // 2. The submap's entries [x_BR, c, f_k...] (c: the current
+  // self-calibration, if any; f_k the features it added), their covariance,
+  // and their covariance with C.
+  std::vector<int> own;  // the submap's features that are not shared
+  std::vector<int> global_of_shared(s.num_features(), -1);
+  for (std::size_t j = 0; j < link.submap_ids.size(); ++j) {
+    const int k = submap.IndexOfId(link.submap_ids[j]);
+    if (k >= 0) global_of_shared[k] = link.global_features[j];
+  }
+  for (int k = 0; k < s.num_features(); ++k) {
+    if (global_of_shared[k] < 0) own.push_back(k);
+  }
+  const int L = static_cast<int>(own.size());
   std::vector<int> entries = {0, 1, 2};
   for (int i = 0; i < nc; ++i) entries.push_back(3 + i);
-  for (int k = 0; k < L; ++k) {
+  for (const int k : own) {
     entries.push_back(s.FeatureIndex(k));
     entries.push_back(s.FeatureIndex(k) + 1);
   }
   const int ns = static_cast<int>(entries.size());
-  const int na = static_cast<int>(shared.entries.size());
   const auto P_sub_full = s.covariance();
   Eigen::MatrixXd P_ss(ns, ns);
-  Eigen::MatrixXd P_s0(ns, na);
+  Eigen::MatrixXd P_sC(ns, na);
   for (int i = 0; i < ns; ++i) {
     for (int j = 0; j < ns; ++j) P_ss(i, j) = P_sub_full(entries[i], entries[j]);
-    for (int j = 0; j < na; ++j) {
-      P_s0(i, j) = P_sub_full(entries[i], s.SharedIndex() + shared.entries[j]);
-    }
+    for (int j = 0; j < na; ++j) P_sC(i, j) = P_sub_full(entries[i], shared.submap_indices[j]);
   }
 
-  // 3. Carried to W: y = [x_B', c, f_W] from x_B and the submap's entries.
-  const Transformed t = ToWorld(s, nc, base);
-  const Eigen::MatrixXd JsP_s0 = t.J_submap * P_s0;  // ny x na
-  // Cov(y, global) and Cov(y, y); the old base and c0 are then left out.
+  // 3. Carried to W: y = [x_B', c, f_W...] from x_B and the submap's entries.
+  const Transformed t = ToWorld(s, nc, own, base);
+  const Eigen::MatrixXd JsP_sC = t.J_submap * P_sC;  // ny x na
   Eigen::MatrixXd P_yg = t.J_base * Pg.topRows<3>();
-  if (na > 0) P_yg.noalias() += JsP_s0 * shared.M;
+  if (na > 0) P_yg.noalias() += JsP_sC * shared.M;
   Eigen::MatrixXd P_yy = t.J_base * Pg.topLeftCorner<3, 3>() * t.J_base.transpose() +
                          t.J_submap * P_ss * t.J_submap.transpose();
   if (na > 0) {
     const Eigen::MatrixXd cross = t.J_base * shared.M.leftCols<3>().transpose() *
-                                  JsP_s0.transpose();  // J_b Cov(x_B, s) J_s^T
+                                  JsP_sC.transpose();  // J_b Cov(x_B, s) J_s^T
     P_yy += cross + cross.transpose();
   }
   P_yy = 0.5 * (P_yy + P_yy.transpose()).eval();
 
-  // The joined state [x_B', c, old features, submap features].
+  // The joined state [x_B', c, old features, the submap's own features];
+  // the old base and C are left out.
   const int nv = 3 + nc;  // y's head: x_B' and c
   const int n = ng + 2 * L;
   const int nF = 2 * Lg;
@@ -249,15 +327,16 @@ JoinReport JoinSubmap(const EkfSlam& submap, double gate, double max_segment_gap
   P.block(ng, 0, 2 * L, nv) = P.block(0, ng, nv, 2 * L).transpose();
   P.block(nv, ng, nF, 2 * L) = P.block(ng, nv, 2 * L, nF).transpose();
 
-  // The submap's features as the global map keeps them.
+  // The submap's own features as the global map keeps them.
   const Pose2 X_WB(base(0), base(1), base(2));
-  for (int k = 0; k < L; ++k) {
+  for (int i = 0; i < L; ++i) {
+    const int k = own[i];
     const FeatureType type = s.feature_type(k);
     map->types.push_back(type);
     map->ids.push_back(-1);  // given below if the feature stays
     if (type == FeatureType::kLine) {
       const Eigen::Vector2d line_B = s.feature(k);
-      const Eigen::Vector2d line_W = x.segment<2>(ng + 2 * k);
+      const Eigen::Vector2d line_W = x.segment<2>(ng + 2 * i);
       map->segments.push_back(
           SegmentFromPoints(line_W, X_WB * PointOnLine(line_B, submap.segment(k).s_min),
                             X_WB * PointOnLine(line_B, submap.segment(k).s_max)));
@@ -266,6 +345,15 @@ JoinReport JoinSubmap(const EkfSlam& submap, double gate, double max_segment_gap
       map->segments.push_back({});
       map->facing.push_back(std::numeric_limits<double>::quiet_NaN());
     }
+  }
+  // The shared lines' segments grow by what the submap saw of them.
+  for (int k = 0; k < s.num_features(); ++k) {
+    const int g = global_of_shared[k];
+    if (g < 0 || s.feature_type(k) != FeatureType::kLine) continue;
+    const Eigen::Vector2d line_B = s.feature(k);
+    map->segments[g] = ExtendSegment(map->segments[g], xg.segment<2>(nv + 2 * g),
+                                     X_WB * PointOnLine(line_B, submap.segment(k).s_min),
+                                     X_WB * PointOnLine(line_B, submap.segment(k).s_max));
   }
   const auto index = [&](int k) { return nv + 2 * k; };
 
@@ -352,6 +440,7 @@ JoinReport JoinSubmap(const EkfSlam& submap, double gate, double max_segment_gap
   // line's segment grows by its submap copy's.
   std::vector<int> keep;  // state entries
   for (int i = 0; i < nv; ++i) keep.push_back(i);
+  std::vector<int> own_index(L, -1);  // each own feature's index in the joined map
   JoinedMap joined;
   joined.calibration_size = nc;
   for (int k = 0; k < Lg + L; ++k) {
@@ -366,7 +455,10 @@ JoinReport JoinSubmap(const EkfSlam& submap, double gate, double max_segment_gap
         map->segments[k] = {-seg.s_max, -seg.s_min};
       }
     }
-    if (k >= Lg && match[k] >= 0) continue;
+    if (k >= Lg) {
+      own_index[k - Lg] = match[k] >= 0 ? match[k] : joined.num_features();
+      if (match[k] >= 0) continue;
+    }
     keep.push_back(ik);
     keep.push_back(ik + 1);
     joined.types.push_back(map->types[k]);
@@ -391,6 +483,8 @@ JoinReport JoinSubmap(const EkfSlam& submap, double gate, double max_segment_gap
     for (int i = 0; i < kept; ++i) joined.covariance(i, j) = P(keep[i], keep[j]);
   }
   *map = std::move(joined);
+  report.global_index = global_of_shared;
+  for (int i = 0; i < L; ++i) report.global_index[own[i]] = own_index[i];
   return report;
 }
 
@@ -408,9 +502,9 @@ SubmapFilter::SubmapFilter(const FilterSettings& settings, const Pose2& X_WR0, c
                      std::to_string(max_features_) + ")");
   }
   // The global map: the base at the initial pose, and the self-calibration's
-  // prior, which the first submap starts from.
-  StartSubmap(nullptr);
-  const SlamState& s = submap_->slam_state();
+  // prior (a submap's, as EkfSlam makes it), which the first submap shares.
+  const EkfSlam prior(params_, mode_, Pose2(), X_RS_);
+  const SlamState& s = prior.slam_state();
   const int nc = s.calibrated() ? SlamState::kCalibrationSize : 0;
   global_.calibration_size = nc;
   global_.mean = Eigen::VectorXd::Zero(3 + nc);
@@ -423,22 +517,41 @@ SubmapFilter::SubmapFilter(const FilterSettings& settings, const Pose2& X_WR0, c
   if (nc > 0) {
     global_.mean.tail(nc) = s.calibration();
     global_.covariance.bottomRightCorner(nc, nc) = s.covariance().block(3, 3, nc, nc);
-    submap_->StartCalibrationFrom(global_.mean.tail(nc),
-                                  global_.covariance.bottomRightCorner(nc, nc));
   }
+  StartSubmap(nullptr, {});
 }
 
-void SubmapFilter::StartSubmap(const SensorRecord* record) {
+void SubmapFilter::StartSubmap(const SensorRecord* record,
+                               const std::vector<int>& global_features) {
   EkfParams params = params_;
   params.initial_position_std_m = 0.0;
   params.initial_heading_std_rad = 0.0;
   submap_ = std::make_unique<EkfSlam>(params, mode_, Pose2(), X_RS_,
                                       rng_.Fork("submap." + std::to_string(num_joins_)));
+  // The shared part: the self-calibration and the features seen last, in B.
+  link_ = LinkOf(global_, global_features);
   const int nc = global_.calibration_size;
-  if (record != nullptr && nc > 0) {
-    // The self-calibration goes on from the global map's estimate, shared.
-    submap_->StartCalibrationFrom(global_.mean.segment(3, nc),
-                                  global_.covariance.block(3, 3, nc, nc));
+  const Eigen::Vector3d base = global_.mean.head<3>();
+  const Pose2 X_BW = Pose2(base(0), base(1), base(2)).Inverse();
+  std::vector<EkfSlam::PriorFeature> features;
+  for (std::size_t j = 0; j < global_features.size(); ++j) {
+    const int g = global_features[j];
+    EkfSlam::PriorFeature f;
+    f.type = global_.types[g];
+    f.params = link_.value.segment<2>(nc + 2 * j);
+    if (f.type == FeatureType::kLine) {
+      const Eigen::Vector2d line_W = global_.mean.segment<2>(3 + nc + 2 * g);
+      f.segment = SegmentFromPoints(f.params,
+                                    X_BW * PointOnLine(line_W, global_.segments[g].s_min),
+                                    X_BW * PointOnLine(line_W, global_.segments[g].s_max));
+      // The side seen from: the normal towards it is -side n.
+      const double facing = global_.facing[g];
+      if (!std::isnan(facing)) f.seen_side = std::cos(facing - base(2) - f.params.y()) < 0.0 ? 1 : -1;
+    }
+    features.push_back(f);
+  }
+  if (nc > 0 || !features.empty()) {
+    link_.submap_ids = submap_->StartFrom(link_.value.head(nc), features, link_.P_CC);
   }
   if (record != nullptr) {
     // The reference of the next increment, with no motion of its own.
@@ -449,49 +562,61 @@ void SubmapFilter::StartSubmap(const SensorRecord* record) {
 }
 
 StepReport SubmapFilter::Step(const SensorRecord& record, const ScanFeatures* features) {
-  StepReport report;
-  double cost_n2 = 0.0;
-  if (features != nullptr && submap_->num_features() >= max_features_) {
-    // The full submap moves to this record and is joined; the new one
-    // starts here and takes the scan, so that it sees its features from
-    // its origin and each scan enters one submap only.
-    submap_->Step(record, nullptr);
-    const JoinReport join =
-        JoinSubmap(*submap_, gate_, params_.line_match_max_gap_m, &global_, &next_id_);
-    const double size = join.state_size;
-    cost_n2 += join.num_matched * size * size;
-    ++num_joins_;
-    StartSubmap(&record);
-    SensorRecord here = record;
-    here.dt_s = 0.0;
-    report = submap_->Step(here, features);
-  } else {
-    report = submap_->Step(record, features);
+  const bool close = features != nullptr && submap_->num_features() >= max_features_;
+  std::vector<int> ids_before;
+  if (close) {
+    for (int k = 0; k < submap_->num_features(); ++k) ids_before.push_back(submap_->id(k));
   }
+  StepReport report = submap_->Step(record, features);
   const double n = submap_->slam_state().dimension();
-  report.correction_cost_n2 = cost_n2 + report.num_updated * n * n;
+  report.correction_cost_n2 = report.num_updated * n * n;
+  if (close) {
+    // The submap ends with this scan and is joined; the next starts here,
+    // sharing the features this scan saw (and the self-calibration).
+    std::vector<bool> seen(submap_->num_features(), false);
+    for (std::size_t i = 0; i < report.association.outcome.size(); ++i) {
+      if (report.association.outcome[i] != AssociationOutcome::kMatched) continue;
+      const int k = submap_->IndexOfId(ids_before[report.association.feature[i]]);
+      if (k >= 0) seen[k] = true;
+    }
+    const int last_id = ids_before.empty() ? -1 : *std::max_element(ids_before.begin(), ids_before.end());
+    for (int k = 0; k < submap_->num_features(); ++k) {
+      if (submap_->id(k) > last_id) seen[k] = true;
+    }
+    const JoinReport join =
+        JoinSubmap(*submap_, link_, gate_, params_.line_match_max_gap_m, &global_, &next_id_);
+    const double size = join.state_size;
+    report.correction_cost_n2 += join.num_matched * size * size;
+    std::vector<int> shared;
+    for (int k = 0; k < submap_->num_features(); ++k) {
+      if (seen[k]) shared.push_back(join.global_index[k]);
+    }
+    std::sort(shared.begin(), shared.end());
+    shared.erase(std::unique(shared.begin(), shared.end()), shared.end());
+    ++num_joins_;
+    StartSubmap(&record, shared);
+  }
   report.num_features = num_features();
   return report;
 }
 
 void SubmapFilter::Base(Eigen::Vector3d* x_B, Eigen::Matrix3d* P_B,
                         Eigen::Matrix3d* C_BR) const {
-  // The base given the submap's estimate of the shared calibration (as
+  // The base given the submap's estimate of the shared part (as
   // JoinSubmap's step 1 would update it), and its covariance with x_BR.
   *x_B = global_.mean.head<3>();
   *P_B = global_.covariance.topLeftCorner<3, 3>();
   C_BR->setZero();
-  const SharedPart shared = SharedPartOf(*submap_, global_);
-  if (shared.entries.empty()) return;
+  const SharedPart shared = SharedPartOf(*submap_, link_, true);
+  if (shared.rows.empty()) return;
   const SlamState& s = submap_->slam_state();
-  const Eigen::MatrixXd M_B = shared.M.leftCols<3>();
-  *x_B += M_B.transpose() * shared.delta;
-  *P_B -= M_B.transpose() * shared.D * M_B;
-  Eigen::MatrixXd P_0R(shared.entries.size(), 3);
-  for (std::size_t i = 0; i < shared.entries.size(); ++i) {
-    P_0R.row(i) = s.covariance().block(s.SharedIndex() + shared.entries[i], 0, 1, 3);
+  *x_B += shared.M.transpose() * shared.delta;
+  *P_B -= shared.M.transpose() * shared.D * shared.M;
+  Eigen::MatrixXd P_CR(shared.rows.size(), 3);
+  for (std::size_t i = 0; i < shared.rows.size(); ++i) {
+    P_CR.row(i) = s.covariance().block(shared.submap_indices[i], 0, 1, 3);
   }
-  *C_BR = M_B.transpose() * P_0R;
+  *C_BR = shared.M.transpose() * P_CR;
 }
 
 Pose2 SubmapFilter::X_WR() const {
@@ -525,7 +650,7 @@ Eigen::Matrix3d SubmapFilter::pose_covariance() const {
 std::vector<MapFeature> SubmapFilter::Map() const {
   JoinedMap joined = global_;
   int next_id = next_id_;
-  JoinSubmap(*submap_, gate_, params_.line_match_max_gap_m, &joined, &next_id);
+  JoinSubmap(*submap_, link_, gate_, params_.line_match_max_gap_m, &joined, &next_id);
   std::vector<MapFeature> map;
   map.reserve(joined.num_features());
   for (int k = 0; k < joined.num_features(); ++k) {

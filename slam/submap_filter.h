@@ -3,6 +3,7 @@
 // Kind "submaps" of the FilterRegistry: EKF-SLAM in bounded submaps joined
 // into a global map (docs/method.md, "Submaps").
 #include <memory>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -37,6 +38,28 @@ struct JoinedMap {
   int num_features() const { return static_cast<int>(types.size()); }
 };
 
+/// What a submap shares with the global map it started from (conditionally
+/// independent submaps): C, the self-calibration c0 (if any) and the
+/// features the last scan of the submap before saw, expressed in the base B,
+/// C = g(global map) with Jacobian G, at the global map as it was when the
+/// submap started; the submap's own copies of those features.
+struct SubmapLink {
+  /// The shared features' indices in the global map, and their ids in the
+  /// submap (in the same order).
+  std::vector<int> global_features;
+  std::vector<int> submap_ids;
+  /// C = [c, f_B...] (nc + 2 per feature), G by rows (sparse: state index,
+  /// value), G P and G P G^T (= P_CC, the submap's prior over C).
+  Eigen::VectorXd value;
+  std::vector<std::vector<std::pair<int, double>>> G;
+  Eigen::MatrixXd GP;
+  Eigen::MatrixXd P_CC;
+};
+
+/// The link of a submap that starts at `map`'s base sharing the
+/// self-calibration and the global features `global_features`.
+SubmapLink LinkOf(const JoinedMap& map, const std::vector<int>& global_features);
+
 /// What one join did.
 struct JoinReport {
   /// The submap's features that matched a feature of the global map (and
@@ -46,13 +69,15 @@ struct JoinReport {
   /// The joined state's size n when the matches were fused (their cost is
   /// num_matched n^2 in the cost model).
   int state_size = 0;
+  /// Each submap feature's index in the joined map.
+  std::vector<int> global_index;
 };
 
 /// Sequential map joining (Tardos, Neira, Newman and Leonard, IJRR 21(4),
 /// 2002) of conditionally independent submaps (Pinies and Tardos, IEEE
 /// T-RO 24(5), 2008): `submap`, an EKF-SLAM whose W is the base frame B of
 /// `map`, started at B with zero covariance and, with self-calibration, from
-/// the map's estimate of it, c0 (SlamState::StartCalibrationFrom), so that
+/// the map's estimate of it, c0 (SlamState::StartFrom), so that
 /// the submap is independent of `map` given c0, is joined into `map`. The
 /// submap's estimate of c0 first updates `map` through its correlations
 /// with c0; the submap's features are carried to W through x_B, its robot
@@ -67,8 +92,8 @@ struct JoinReport {
 /// update with the identity constraint f_submap - f_global = 0, after which
 /// the submap's copy is removed. The submap's self-calibration entries, if
 /// any, are left out (marginalised). New features take ids from *next_id.
-JoinReport JoinSubmap(const EkfSlam& submap, double gate, double max_segment_gap_m,
-                      JoinedMap* map, int* next_id);
+JoinReport JoinSubmap(const EkfSlam& submap, const SubmapLink& link, double gate,
+                      double max_segment_gap_m, JoinedMap* map, int* next_id);
 
 /// Kind "submaps": the paper's EKF-SLAM (`update: classical` or
 /// `selective`, as kind ekf) run in a local submap that starts empty at the
@@ -106,11 +131,11 @@ class SubmapFilter : public Filter {
   int num_joins() const { return num_joins_; }
 
  private:
-  // A new, empty submap at the base of global_, its self-calibration from
-  // global_'s, primed with `record` as its odometry and command reference
-  // (its first step predicts no motion). Without a record: the first
-  // submap, whose calibration prior global_ takes.
-  void StartSubmap(const SensorRecord* record);
+  // A new submap at the base of global_, sharing its self-calibration and
+  // the features `global_features` (link_), primed with `record` (if any)
+  // as its odometry and command reference (its first step predicts no
+  // motion).
+  void StartSubmap(const SensorRecord* record, const std::vector<int>& global_features);
   // The base x_B given the submap's estimate of the shared calibration,
   // its covariance, and its covariance with the submap's pose x_BR.
   void Base(Eigen::Vector3d* x_B, Eigen::Matrix3d* P_B, Eigen::Matrix3d* C_BR) const;
@@ -124,6 +149,7 @@ class SubmapFilter : public Filter {
   double gate_;
   JoinedMap global_;
   std::unique_ptr<EkfSlam> submap_;
+  SubmapLink link_;
   int num_joins_ = 0;
   int next_id_ = 0;
 };
