@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <memory>
 #include <vector>
 
 #include <Eigen/Core>
@@ -28,6 +29,7 @@
 #include "slam/feature_extraction.h"
 #include "slam/observations.h"
 #include "slam/slam_params.h"
+#include "slam/submap_filter.h"
 
 namespace mjslam::slam {
 namespace {
@@ -304,6 +306,116 @@ LaserScan RoomScan() {
   }
   return scan;
 }
+
+// Kind submaps in a long corridor of posts (corners 1 m apart on both
+// sides, seen within 6 m): `SubmapCorridor(n)` drives until the global map
+// holds n features and a submap has just started.
+constexpr double kPostSpacing = 1.0;
+
+ScanFeatures PostsSeenFrom(double x, Rng* rng) {
+  ScanFeatures features;
+  for (int i = static_cast<int>(std::floor((x - 6.0) / kPostSpacing));
+       i <= static_cast<int>(std::ceil((x + 6.0) / kPostSpacing)); ++i) {
+    for (const double y : {-2.0, 2.0}) {
+      const Eigen::Vector2d p(i * kPostSpacing - x, y);
+      if (i < 0 || p.norm() > 6.0) continue;
+      CornerObservation corner;
+      corner.range_m = p.norm() + rng->Gaussian(0.0, 0.01);
+      corner.bearing_rad = std::atan2(p.y(), p.x()) + rng->Gaussian(0.0, 0.003);
+      corner.covariance = Eigen::Vector2d(0.01 * 0.01, 0.003 * 0.003).asDiagonal();
+      corner.p_SC = corner.range_m *
+                    Eigen::Vector2d(std::cos(corner.bearing_rad), std::sin(corner.bearing_rad));
+      features.corners.push_back(corner);
+    }
+  }
+  return features;
+}
+
+FilterSettings SubmapSettings(CorrectionMode mode) {
+  FilterSettings settings;
+  settings.slam.ekf.process_model = CommandProcessModel{};
+  settings.filter.name = "submaps";
+  settings.filter.kind = "submaps";
+  settings.filter.update = mode == CorrectionMode::kClassical ? "classical" : "selective";
+  settings.filter.submap_max_features = 40;
+  return settings;
+}
+
+struct Corridor {
+  std::unique_ptr<SubmapFilter> filter;
+  double x = 0.0;
+};
+
+Corridor SubmapCorridor(int num_features, CorrectionMode mode) {
+  Corridor c{std::make_unique<SubmapFilter>(SubmapSettings(mode), Pose2(), Pose2(), Rng(1)), 0.0};
+  Rng rng(5);
+  SensorRecord record;
+  record.dt_s = 0.5;
+  record.command = {1.0, 0.0};
+  int joins = 0;
+  while (c.filter->global_map().num_features() < num_features || c.filter->num_joins() == joins) {
+    joins = c.filter->num_joins();
+    c.x += 0.5;
+    const ScanFeatures seen = PostsSeenFrom(c.x, &rng);
+    c.filter->Step(record, &seen);
+  }
+  return c;
+}
+
+void SubmapSizes(benchmark::internal::Benchmark* b) {
+  for (const int size : {100, 300, 1000}) b->Arg(size);
+}
+
+// One step of kind submaps standing still (its scan matches its submap, no
+// join): flat in the size of the global map.
+void SubmapStepBenchmark(benchmark::State& state, CorrectionMode mode) {
+  Corridor c = SubmapCorridor(static_cast<int>(state.range(0)), mode);
+  Rng rng(11);
+  const ScanFeatures seen = PostsSeenFrom(c.x, &rng);
+  SensorRecord still;
+  for (auto _ : state) {
+    c.filter->Step(still, &seen);
+    benchmark::ClobberMemory();
+  }
+  state.counters["global_features"] = c.filter->global_map().num_features();
+  state.counters["submap_features"] = c.filter->submap().num_features();
+  state.counters["joins"] = c.filter->num_joins();
+}
+void BM_SubmapClassicalStep(benchmark::State& state) {
+  SubmapStepBenchmark(state, CorrectionMode::kClassical);
+}
+BENCHMARK(BM_SubmapClassicalStep)->Apply(SubmapSizes)->Unit(benchmark::kMicrosecond);
+void BM_SubmapSelectiveStep(benchmark::State& state) {
+  SubmapStepBenchmark(state, CorrectionMode::kSelective);
+}
+BENCHMARK(BM_SubmapSelectiveStep)->Apply(SubmapSizes)->Unit(benchmark::kMicrosecond);
+
+// One join of the current submap into (a copy of) the global map: O(n^2)
+// in the global map's size per fused pair.
+void BM_SubmapJoin(benchmark::State& state) {
+  Corridor c = SubmapCorridor(static_cast<int>(state.range(0)), CorrectionMode::kSelective);
+  Rng rng(11);
+  SensorRecord record;
+  record.dt_s = 0.5;
+  record.command = {1.0, 0.0};
+  for (int i = 0; i < 10; ++i) {
+    c.x += 0.5;
+    const ScanFeatures seen = PostsSeenFrom(c.x, &rng);
+    c.filter->Step(record, &seen);
+  }
+  JoinReport report;
+  for (auto _ : state) {
+    JoinedMap map = c.filter->global_map();
+    int next_id = 0;
+    report = JoinSubmap(c.filter->submap(), c.filter->link(), ChiSquare2Quantile(0.99), 0.0,
+                        &map, &next_id);
+    benchmark::ClobberMemory();
+  }
+  state.counters["global_features"] = c.filter->global_map().num_features();
+  state.counters["fused"] = report.num_matched;
+}
+BENCHMARK(BM_SubmapJoin)->Apply(SubmapSizes)->Unit(benchmark::kMillisecond);
+
 
 void BM_FeatureExtraction(benchmark::State& state) {
   const LaserScan scan = RoomScan();

@@ -247,7 +247,6 @@ JoinReport JoinSubmap(const EkfSlam& submap, const SubmapLink& link, double gate
   const int nc = map->calibration_size;
   const int Lg = map->num_features();
   const int ng = 3 + nc + 2 * Lg;
-  const Eigen::Vector3d base = map->mean.head<3>();
 
   // 1. The shared part C (the self-calibration at the submap's start, c0,
   // and the features the submap started with) updates the global map
@@ -264,6 +263,7 @@ JoinReport JoinSubmap(const EkfSlam& submap, const SubmapLink& link, double gate
     Pg.noalias() -= shared.M.transpose() * DM;
     Pg = 0.5 * (Pg + Pg.transpose()).eval();
   }
+  const Eigen::Vector3d base = xg.head<3>();
 
   // 2. The submap's entries [x_BR, c, f_k...] (c: the current
   // self-calibration, if any; f_k the features it added), their covariance,

@@ -127,6 +127,8 @@ class SubmapFilter : public Filter {
   const JoinedMap& global_map() const { return global_; }
   /// The current submap.
   const EkfSlam& submap() const { return *submap_; }
+  /// What the current submap shares with the global map.
+  const SubmapLink& link() const { return link_; }
   /// The number of submaps joined so far.
   int num_joins() const { return num_joins_; }
 
