@@ -407,7 +407,7 @@ void BM_SubmapJoin(benchmark::State& state) {
   for (auto _ : state) {
     JoinedMap map = c.filter->global_map();
     int next_id = 0;
-    report = JoinSubmap(c.filter->submap(), c.filter->link(), ChiSquare2Quantile(0.99), 0.0,
+    report = JoinSubmap(c.filter->submap(), c.filter->link(), EkfParams(),
                         &map, &next_id);
     benchmark::ClobberMemory();
   }

@@ -25,6 +25,12 @@ constexpr double kPi = 3.14159265358979323846;
 // corner made from two lines that match too).
 constexpr double kConstraintVariance = 1e-10;
 
+// The variance the gate of a join adds to the first-order S of a pair's
+// difference: 1 mm (and 0.1 mrad), the order of a feature's error when
+// seen once.
+const Eigen::Vector2d kLineResidue(1e-6, 1e-8);
+const Eigen::Vector2d kCornerResidue(1e-6, 1e-6);
+
 // The quantities a join carries to W, y = [x_B', c, f_k...] of the submap
 // (c: its nc self-calibration entries as they are now; f_k its features
 // listed), with their Jacobians by the old base x_B and by the submap's
@@ -188,6 +194,8 @@ struct SharedPart {
   std::vector<int> rows;
   std::vector<int> submap_indices;
   Eigen::VectorXd delta;
+  // +1, or -1 on the r row of a line whose form flipped in the submap.
+  Eigen::VectorXd sign;
   Eigen::MatrixXd D;
   // P_CC^-1 over the rows, as an LDLT.
   Eigen::LDLT<Eigen::MatrixXd> P_CC;
@@ -222,15 +230,29 @@ SharedPart SharedPartOf(const EkfSlam& submap, const SubmapLink& link, bool base
   Eigen::MatrixXd P_new(na, na);
   Eigen::MatrixXd GP(na, base_only ? 3 : link.GP.cols());
   shared.delta.resize(na);
+  shared.sign = Eigen::VectorXd::Ones(na);
   for (int i = 0; i < na; ++i) {
     const int r = shared.rows[i];
-    shared.delta(i) = s.mean()(shared.submap_indices[i]) - link.value(r);
-    // A line's angle (the second row of its pair) wraps.
-    if (r >= nc && (r - nc) % 2 == 1) shared.delta(i) = WrapAngle(shared.delta(i));
+    const double value = s.mean()(shared.submap_indices[i]);
+    shared.delta(i) = value - link.value(r);
+    if (r >= nc && (r - nc) % 2 == 1) {
+      // A line's angle: wrapped; a line whose form flipped in the submap
+      // ((r, al) became (-r, al + pi), r crossing 0) is compared in the
+      // link's form, its r row negated.
+      shared.delta(i) = WrapAngle(shared.delta(i));
+      if (std::abs(shared.delta(i)) > kPi / 2) {
+        shared.delta(i) = WrapAngle(shared.delta(i) + kPi);
+        shared.sign(i - 1) = -1.0;
+        shared.delta(i - 1) = -s.mean()(shared.submap_indices[i - 1]) - link.value(r - 1);
+      }
+    }
     GP.row(i) = link.GP.row(r).head(GP.cols());
+  }
+  for (int i = 0; i < na; ++i) {
     for (int j = 0; j < na; ++j) {
-      P_CC(i, j) = link.P_CC(r, shared.rows[j]);
-      P_new(i, j) = P_sub(shared.submap_indices[i], shared.submap_indices[j]);
+      P_CC(i, j) = link.P_CC(shared.rows[i], shared.rows[j]);
+      P_new(i, j) = shared.sign(i) * shared.sign(j) *
+                    P_sub(shared.submap_indices[i], shared.submap_indices[j]);
     }
   }
   shared.D = P_CC - P_new;
@@ -241,8 +263,9 @@ SharedPart SharedPartOf(const EkfSlam& submap, const SubmapLink& link, bool base
 
 }  // namespace
 
-JoinReport JoinSubmap(const EkfSlam& submap, const SubmapLink& link, double gate,
-                      double max_segment_gap_m, JoinedMap* map, int* next_id) {
+JoinReport JoinSubmap(const EkfSlam& submap, const SubmapLink& link, const EkfParams& params,
+                      JoinedMap* map, int* next_id) {
+  const double gate = ChiSquare2Quantile(params.gate_probability);
   const SlamState& s = submap.slam_state();
   const int nc = map->calibration_size;
   const int Lg = map->num_features();
@@ -290,7 +313,9 @@ JoinReport JoinSubmap(const EkfSlam& submap, const SubmapLink& link, double gate
   Eigen::MatrixXd P_sC(ns, na);
   for (int i = 0; i < ns; ++i) {
     for (int j = 0; j < ns; ++j) P_ss(i, j) = P_sub_full(entries[i], entries[j]);
-    for (int j = 0; j < na; ++j) P_sC(i, j) = P_sub_full(entries[i], shared.submap_indices[j]);
+    for (int j = 0; j < na; ++j) {
+      P_sC(i, j) = shared.sign(j) * P_sub_full(entries[i], shared.submap_indices[j]);
+    }
   }
 
   // 3. Carried to W: y = [x_B', c, f_W...] from x_B and the submap's entries.
@@ -372,27 +397,33 @@ JoinReport JoinSubmap(const EkfSlam& submap, const SubmapLink& link, double gate
         const double fa = map->facing[a];
         const double fb = map->facing[b];
         if (!std::isnan(fa) && !std::isnan(fb) && std::cos(fa - fb) <= 0.0) continue;
-        if (!SegmentsMeet(f_a, map->segments[a], f_b, map->segments[b], max_segment_gap_m)) {
+        if (!SegmentsMeet(f_a, map->segments[a], f_b, map->segments[b],
+                          params.line_match_max_gap_m)) {
           continue;
         }
       }
       Eigen::Matrix2d A;
       const Eigen::Vector2d d = Difference(map->types[a], f_a, f_b, &A);
       const Eigen::Matrix2d P_ab = P.block<2, 2>(ia, ib);
-      const Eigen::Matrix2d S = A * P_aa * A.transpose() + P.block<2, 2>(ib, ib) -
-                                A * P_ab - P_ab.transpose() * A.transpose();
+      Eigen::Matrix2d S = A * P_aa * A.transpose() + P.block<2, 2>(ib, ib) - A * P_ab -
+                          P_ab.transpose() * A.transpose();
+      // The first-order S misses the linearisation's residue, which matters
+      // where the two are nearly one function of the same entries (a corner
+      // of two shared lines).
+      S += (map->types[a] == FeatureType::kLine ? kLineResidue : kCornerResidue).asDiagonal();
       const double d2 = d.dot(S.ldlt().solve(d));
       if (d2 < gate) pairs.emplace_back(d2, a, b);
     }
   }
+  // Each submap feature takes its nearest; a global feature may take
+  // several (a wall the submap mapped twice, in pieces that its own
+  // duplicate test had not yet joined).
   std::sort(pairs.begin(), pairs.end());
   std::vector<int> match(Lg + L, -1);
-  std::vector<bool> taken(Lg, false);
   std::vector<std::pair<int, int>> matches;
   for (const auto& [d2, a, b] : pairs) {
-    if (match[a] >= 0 || taken[b]) continue;
+    if (match[a] >= 0) continue;
     match[a] = b;
-    taken[b] = true;
     matches.emplace_back(a, b);
   }
 
@@ -495,8 +526,7 @@ SubmapFilter::SubmapFilter(const FilterSettings& settings, const Pose2& X_WR0, c
       X_RS_(X_RS),
       rng_(std::move(rng)),
       odometry_(PredictsFromOdometry(settings.slam.ekf.process_model)),
-      max_features_(settings.filter.submap_max_features),
-      gate_(ChiSquare2Quantile(settings.slam.ekf.gate_probability)) {
+      max_features_(settings.filter.submap_max_features) {
   if (max_features_ < 1) {
     throw ParamError("submap_max_features: expected a value >= 1 (got " +
                      std::to_string(max_features_) + ")");
@@ -584,7 +614,7 @@ StepReport SubmapFilter::Step(const SensorRecord& record, const ScanFeatures* fe
       if (submap_->id(k) > last_id) seen[k] = true;
     }
     const JoinReport join =
-        JoinSubmap(*submap_, link_, gate_, params_.line_match_max_gap_m, &global_, &next_id_);
+        JoinSubmap(*submap_, link_, params_, &global_, &next_id_);
     const double size = join.state_size;
     report.correction_cost_n2 += join.num_matched * size * size;
     std::vector<int> shared;
@@ -614,7 +644,7 @@ void SubmapFilter::Base(Eigen::Vector3d* x_B, Eigen::Matrix3d* P_B,
   *P_B -= shared.M.transpose() * shared.D * shared.M;
   Eigen::MatrixXd P_CR(shared.rows.size(), 3);
   for (std::size_t i = 0; i < shared.rows.size(); ++i) {
-    P_CR.row(i) = s.covariance().block(shared.submap_indices[i], 0, 1, 3);
+    P_CR.row(i) = shared.sign(i) * s.covariance().block(shared.submap_indices[i], 0, 1, 3);
   }
   *C_BR = shared.M.transpose() * P_CR;
 }
@@ -650,7 +680,7 @@ Eigen::Matrix3d SubmapFilter::pose_covariance() const {
 std::vector<MapFeature> SubmapFilter::Map() const {
   JoinedMap joined = global_;
   int next_id = next_id_;
-  JoinSubmap(*submap_, link_, gate_, params_.line_match_max_gap_m, &joined, &next_id);
+  JoinSubmap(*submap_, link_, params_, &joined, &next_id);
   std::vector<MapFeature> map;
   map.reserve(joined.num_features());
   for (int k = 0; k < joined.num_features(); ++k) {

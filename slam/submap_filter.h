@@ -75,25 +75,23 @@ struct JoinReport {
 
 /// Sequential map joining (Tardos, Neira, Newman and Leonard, IJRR 21(4),
 /// 2002) of conditionally independent submaps (Pinies and Tardos, IEEE
-/// T-RO 24(5), 2008): `submap`, an EKF-SLAM whose W is the base frame B of
-/// `map`, started at B with zero covariance and, with self-calibration, from
-/// the map's estimate of it, c0 (SlamState::StartFrom), so that
-/// the submap is independent of `map` given c0, is joined into `map`. The
-/// submap's estimate of c0 first updates `map` through its correlations
-/// with c0; the submap's features are carried to W through x_B, its robot
-/// pose becomes the new base and its current self-calibration the map's
-/// (the old base and c0 are marginalised), the covariance propagated to
-/// first order with the cross terms through x_B and c0; then each
-/// submap feature is matched to the global feature nearest in the Mahalanobis
-/// distance of their difference (gate `gate` on chi-square 2 dof, the same
-/// type, a line seen from the same side with seen segments within
-/// `max_segment_gap_m` when > 0; each global feature takes at most one, the
-/// closest pairs first) and the matched pairs are fused by one batch EKF
-/// update with the identity constraint f_submap - f_global = 0, after which
-/// the submap's copy is removed. The submap's self-calibration entries, if
-/// any, are left out (marginalised). New features take ids from *next_id.
-JoinReport JoinSubmap(const EkfSlam& submap, const SubmapLink& link, double gate,
-                      double max_segment_gap_m, JoinedMap* map, int* next_id);
+/// T-RO 24(5), 2008; docs/method.md, "Submaps"). `submap` is an EKF-SLAM
+/// whose W is the base frame B of `map`, started at B with zero covariance
+/// and with the shared part C of `link` as its prior, so that it is
+/// independent of `map` given C. The join: the submap's estimate of C
+/// updates `map` through its correlations with C; the submap's robot pose
+/// and own features are carried to W through x_B (first order, the cross
+/// terms through x_B and C), the pose becoming the new base and the current
+/// self-calibration the map's; then each own feature is matched to the
+/// global feature nearest in the Mahalanobis distance of their difference
+/// (the gate of `params.gate_probability`, the same type, a line seen from
+/// the same side with seen segments within `params.line_match_max_gap_m`; a
+/// global feature may take several, a wall the submap mapped in pieces), the
+/// pairs are fused by one batch EKF update with the identity constraint
+/// f_submap - f_global = 0, and the submap's copies removed. New features
+/// take ids from *next_id.
+JoinReport JoinSubmap(const EkfSlam& submap, const SubmapLink& link, const EkfParams& params,
+                      JoinedMap* map, int* next_id);
 
 /// Kind "submaps": the paper's EKF-SLAM (`update: classical` or
 /// `selective`, as kind ekf) run in a local submap that starts empty at the
@@ -148,7 +146,6 @@ class SubmapFilter : public Filter {
   Rng rng_;
   bool odometry_;
   int max_features_;
-  double gate_;
   JoinedMap global_;
   std::unique_ptr<EkfSlam> submap_;
   SubmapLink link_;

@@ -62,7 +62,7 @@ TEST(JoinSubmapTest, CarriesTheSubmapToItsBase) {
   JoinedMap map;
   map.mean = Eigen::Vector3d(1.0, -2.0, 0.5);
   int next_id = 0;
-  const JoinReport report = JoinSubmap(submap, LinkOf(map, {}), Gate(), 0.0, &map, &next_id);
+  const JoinReport report = JoinSubmap(submap, LinkOf(map, {}), Params(), &map, &next_id);
   EXPECT_EQ(report.num_matched, 0);
   EXPECT_EQ(report.num_new, 3);
   ASSERT_EQ(map.num_features(), 3);
@@ -86,10 +86,10 @@ TEST(JoinSubmapTest, CarriesTheSubmapToItsBase) {
 TEST(JoinSubmapTest, FusesTheFeaturesASecondSubmapSeesAgain) {
   JoinedMap map;
   int next_id = 0;
-  JoinSubmap(SubmapOfWalls(), LinkOf(map, {}), Gate(), 0.5, &map, &next_id);
+  JoinSubmap(SubmapOfWalls(), LinkOf(map, {}), Params(), &map, &next_id);
   const Eigen::Matrix2d P_first = map.covariance.block<2, 2>(3, 3);
   // The same walls seen again from the same place, in a new submap.
-  const JoinReport report = JoinSubmap(SubmapOfWalls(), LinkOf(map, {}), Gate(), 0.5, &map, &next_id);
+  const JoinReport report = JoinSubmap(SubmapOfWalls(), LinkOf(map, {}), Params(), &map, &next_id);
   EXPECT_EQ(report.num_matched, 3);
   EXPECT_EQ(report.num_new, 0);
   EXPECT_EQ(map.num_features(), 3);
@@ -102,14 +102,14 @@ TEST(JoinSubmapTest, FusesTheFeaturesASecondSubmapSeesAgain) {
 TEST(JoinSubmapTest, AWallSeenFromItsOtherSideIsNotFused) {
   JoinedMap map;
   int next_id = 0;
-  JoinSubmap(SubmapOfWalls(), LinkOf(map, {}), Gate(), 0.0, &map, &next_id);
+  JoinSubmap(SubmapOfWalls(), LinkOf(map, {}), Params(), &map, &next_id);
   // The wall x = 2 seen from x = 4 (its other face), as the only feature.
   EkfSlam other(Params(), CorrectionMode::kClassical, Pose2(), Pose2());
   ScanFeatures back;
   back.lines.push_back(Line(2.0, kPi, {-2.0, 1.0}, {-2.0, -1.0}));
   other.Step(SensorRecord{}, &back);
   map.mean.head<3>() = Eigen::Vector3d(4.0, 0.0, 0.0);
-  const JoinReport report = JoinSubmap(other, LinkOf(map, {}), Gate(), 0.0, &map, &next_id);
+  const JoinReport report = JoinSubmap(other, LinkOf(map, {}), Params(), &map, &next_id);
   EXPECT_EQ(report.num_matched, 0);
   EXPECT_EQ(map.num_features(), 4);
 }
