@@ -474,6 +474,14 @@ void SceneRenderer::Impl::AddLayers(const SceneFrame& frame) {
     const double half_m = (1.5 + 1.5 * static_cast<double>(n - i)) * pixel_m;
     for (const Eigen::Vector2d& p : f.corners) AddMarker(p, kMapLayerZ + 0.005 * i, half_m, f.color);
   }
+  for (std::size_t i = 0; i < n; ++i) {
+    // Submap starts: a bar across the path, 16 pixels long.
+    const FilterLayer& f = frame.filters[i];
+    for (const Pose2& X_WR : f.submap_starts) {
+      const Eigen::Vector2d across = 8.0 * pixel_m * Eigen::Vector2d(-std::sin(X_WR.theta), std::cos(X_WR.theta));
+      AddSegment(X_WR.translation() - across, X_WR.translation() + across, kEllipseLayerZ, f.color, 3.0);
+    }
+  }
   for (const Eigen::Vector2d& p : frame.laser_hits) AddMarker(p, kHitLayerZ, 1.0 * pixel_m, colors::kLaserHits);
   for (std::size_t i = 0; i < frame.filters.size(); ++i) {
     const FilterLayer& f = frame.filters[i];
@@ -516,7 +524,10 @@ Image SceneRenderer::Impl::DrawAndRead(const SceneFrame& frame) {
 
 std::vector<LegendEntry> SceneRenderer::Impl::LegendEntries(const SceneFrame& frame) const {
   std::vector<LegendEntry> entries = {{"true path", colors::kTruth}};
-  for (const FilterLayer& f : frame.filters) entries.push_back({f.name, f.color});
+  for (const FilterLayer& f : frame.filters) {
+    entries.push_back({f.name, f.color});
+    if (!f.submap_starts.empty()) entries.push_back({"  | new submap", f.color});
+  }
   entries.push_back({"laser hits", colors::kLaserHits});
   entries.push_back({"robot (true pose)", colors::kRobot});
   if (frame.explorer) {

@@ -51,6 +51,9 @@ struct FilterLayer {
   /// Map: line features as their seen segments, corners as points, W frame.
   std::vector<Segment2> lines;
   std::vector<Eigen::Vector2d> corners;
+  /// A filter of submaps: its estimated pose where each submap began, drawn
+  /// as a bar across its path.
+  std::vector<Pose2> submap_starts;
 };
 
 /// The explorer's current sets (explorer.csv), W frame.

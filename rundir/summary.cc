@@ -50,6 +50,10 @@ nlohmann::json ToJson(const RunSummary& summary) {
           {"copies", f.copies},
           {"copied_scans", f.copied_scans},
           {"map_copied_at_s", time_or_null(f.map_copied_at_s)}}}};
+    if (!f.submap_starts_s.empty()) {
+      json["filters"][f.name]["submaps"] = {{"count", f.submap_starts_s.size() + 1},
+                                            {"started_at_s", f.submap_starts_s}};
+    }
   }
   return json;
 }

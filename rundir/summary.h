@@ -69,6 +69,9 @@ struct RunSummary {
     long copies = 0;
     int copied_scans = 0;
     std::optional<double> map_copied_at_s;
+    /// A filter of submaps (slam::Filter::SubmapStartTimes): when each
+    /// submap after the first began, seconds (empty: none, not written).
+    std::vector<double> submap_starts_s;
   };
   std::vector<Filter> filters;
 };

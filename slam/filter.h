@@ -54,6 +54,9 @@ class Filter {
   /// processes, with dt the time since its last one; one of command input
   /// is given each skipped record's command first (prediction only).
   virtual bool predicts_from_odometry() const = 0;
+  /// A filter that keeps its map in submaps: the times (records' t_s) at
+  /// which each submap after the first began, in order; empty for others.
+  virtual std::vector<double> SubmapStartTimes() const { return {}; }
 };
 
 /// What a filter is built from: its entry and the run's SLAM settings with

@@ -624,6 +624,7 @@ StepReport SubmapFilter::Step(const SensorRecord& record, const ScanFeatures* fe
     std::sort(shared.begin(), shared.end());
     shared.erase(std::unique(shared.begin(), shared.end()), shared.end());
     ++num_joins_;
+    start_times_.push_back(record.t_s);
     StartSubmap(&record, shared);
   }
   report.num_features = num_features();

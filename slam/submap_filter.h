@@ -120,6 +120,7 @@ class SubmapFilter : public Filter {
   /// fuse with global ones).
   int num_features() const override;
   bool predicts_from_odometry() const override { return odometry_; }
+  std::vector<double> SubmapStartTimes() const override { return start_times_; }
 
   /// The global map as joined so far (without the current submap).
   const JoinedMap& global_map() const { return global_; }
@@ -150,6 +151,7 @@ class SubmapFilter : public Filter {
   std::unique_ptr<EkfSlam> submap_;
   SubmapLink link_;
   int num_joins_ = 0;
+  std::vector<double> start_times_;
   int next_id_ = 0;
 };
 

@@ -295,6 +295,7 @@ rundir::RunSummary ClosedLoop::Summary(bool interrupted) const {
     filter.open_loop_s = filters_->open_loop_s(f);
     filter.scans_processed = filters_->scans_processed(f);
     filter.scans_skipped = filters_->scans_skipped(f);
+    filter.submap_starts_s = filters_->filter(f).SubmapStartTimes();
     const slam::InnovationCheckResult check = filters_->innovation_check(f);
     filter.innovation_windows = check.windows;
     filter.innovation_failed_windows = check.failed_windows;

@@ -33,6 +33,10 @@ void LiveVideo::Step(double t_s, const Pose2& X_WR_true, const FilterBank& slam,
     AppendPathPoint(&layer.path, X_WR.translation(), min_step_m_);
     layer.X_WR = X_WR;
     layer.P_xy = slam.filter(i).pose_covariance().topLeftCorner<2, 2>();
+    // A submap that began this step: its start, where the filter is now.
+    if (slam.filter(i).SubmapStartTimes().size() > layer.submap_starts.size()) {
+      layer.submap_starts.push_back(X_WR);
+    }
   }
   if (scan != nullptr) {
     frame_.laser_hits = LaserHits(X_WS, scan->ranges_m, scan->max_range_m, scan->angle_min_rad,

@@ -24,6 +24,7 @@
 #include "rundir/layout.h"
 #include "rundir/map_csv.h"
 #include "rundir/rows.h"
+#include "rundir/summary.h"
 #include "renders/video_writer.h"
 #include "sim/scene.h"
 
@@ -56,6 +57,16 @@ std::vector<ExplorerSnapshot> ReadExplorer(const std::string& path) {
 // The map of a map CSV file into `layer` (none when the file is missing).
 void ReadMap(const std::string& path, renders::FilterLayer* layer) {
   if (fs::exists(path)) SetMapLayer(rundir::ReadMapCsv(path), layer);
+}
+
+// The value at `path` in `json` (null: none).
+const nlohmann::json* FindPath(const nlohmann::json& json, std::initializer_list<std::string> path) {
+  const nlohmann::json* node = &json;
+  for (const std::string& key : path) {
+    if (!node->is_object() || !node->contains(key)) return nullptr;
+    node = &(*node)[key];
+  }
+  return node;
 }
 
 constexpr char kPython[] = "/usr/bin/python3";
@@ -131,6 +142,14 @@ class RunPlayback {
     }
     frame_.filters = FilterLayers(names);
     for (std::size_t i = 0; i < names.size(); ++i) filter_of_layer_.push_back(i);
+    // Filters of submaps: when each submap began (summary.json).
+    const nlohmann::json summary = rundir::ReadSummary(dir.string());
+    submap_starts_.resize(names.size());
+    next_submap_.assign(names.size(), 0);
+    for (std::size_t i = 0; i < names.size(); ++i) {
+      const nlohmann::json* f = FindPath(summary, {"filters", names[i], "submaps", "started_at_s"});
+      if (f != nullptr && f->is_array()) submap_starts_[i] = f->get<std::vector<double>>();
+    }
   }
 
   /// Time of the last row, seconds.
@@ -169,6 +188,11 @@ class RunPlayback {
         AppendPathPoint(&layer.path, {f.X_WR.x, f.X_WR.y}, min_step_m_, last);
         layer.X_WR = f.X_WR;
         layer.P_xy = f.P.topLeftCorner<2, 2>();
+        const std::vector<double>& starts = submap_starts_[i];
+        while (next_submap_[i] < starts.size() && starts[next_submap_[i]] <= row.t_s + 1e-9) {
+          layer.submap_starts.push_back(f.X_WR);
+          ++next_submap_[i];
+        }
       }
       ++next_row_;
     }
@@ -198,6 +222,9 @@ class RunPlayback {
   // The filter (in the trajectory's order) of each of frame_.filters.
   std::vector<std::size_t> filter_of_layer_;
   std::size_t next_row_ = 0;
+  // Per layer: the times its submaps began, and the next not yet drawn.
+  std::vector<std::vector<double>> submap_starts_;
+  std::vector<std::size_t> next_submap_;
 };
 
 // video.mp4: one frame per params.speedup / params.fps simulated seconds,
