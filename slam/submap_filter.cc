@@ -7,7 +7,7 @@
 #include <tuple>
 #include <utility>
 
-#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 
 #include "common/check.h"
 #include "slam/data_association.h"
@@ -21,8 +21,7 @@ constexpr double kPi = 3.14159265358979323846;
 
 // The variance of the identity constraint f_submap - f_global = 0 that fuses
 // a matched pair (metres^2, radians^2): far below any feature's, it only
-// keeps the batch's S positive definite when constraints are redundant (a
-// corner made from two lines that match too).
+// keeps the batch's S positive definite when constraints are redundant.
 constexpr double kConstraintVariance = 1e-10;
 
 // The variance the gate of a join adds to the first-order S of a pair's
@@ -452,13 +451,13 @@ JoinReport JoinSubmap(const EkfSlam& submap, const SubmapLink& link, const EkfPa
           As[i] * PHt.middleRows<2>(index(a)) - PHt.middleRows<2>(index(b));
     }
     S = 0.5 * (S + S.transpose()).eval();
-    // A hard constraint, kept positive definite where constraints are
-    // redundant (a corner made from two lines that match too).
-    S.diagonal().array() += kConstraintVariance;
-    const Eigen::LLT<Eigen::MatrixXd> llt(S);
-    MJSLAM_CHECK(llt.info() == Eigen::Success);
-    const Eigen::MatrixXd W =
-        llt.matrixU().solve(Eigen::MatrixXd::Identity(2 * m, 2 * m));  // S^-1 = W W^T
+    // A hard constraint: S + sigma^2 I = W^-T W^-1, its eigenvalues clamped
+    // at 0 first (round-off can leave one a little below where constraints
+    // are redundant: a corner made from two lines that match too).
+    const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(S);
+    const Eigen::VectorXd inverse_sqrt =
+        (eigen.eigenvalues().cwiseMax(0.0).array() + kConstraintVariance).rsqrt();
+    const Eigen::MatrixXd W = eigen.eigenvectors() * inverse_sqrt.asDiagonal();  // S^-1 = W W^T
     // K nu = V W^T nu and P <- P - V V^T, with V = P H^T W.
     const Eigen::MatrixXd V = PHt * W;
     x.noalias() += V * (W.transpose() * nu);
