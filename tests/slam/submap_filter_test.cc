@@ -12,6 +12,8 @@
 #include "slam/filter.h"
 #include "slam/innovation_check.h"
 #include "slam/data_association.h"
+#include "slam/observation_models.h"
+#include "tests/slam/ekf_test_utils.h"
 
 namespace mjslam::slam {
 namespace {
@@ -81,6 +83,47 @@ TEST(JoinSubmapTest, CarriesTheSubmapToItsBase) {
   EXPECT_NEAR((map.mean.segment<2>(7) - X_WB * p_B).norm(), 0.0, 1e-12);
   const Eigen::Matrix2d P_W = R * submap.slam_state().feature_covariance(2) * R.transpose();
   EXPECT_NEAR((map.covariance.block<2, 2>(7, 7) - P_W).norm(), 0.0, 1e-15);
+}
+
+TEST(JoinSubmapTest, CarriesTheBasesUncertaintyToFirstOrder) {
+  // The base uncertain: each feature's covariance in W is J P J^T over the
+  // base and the feature, J by central differences of the carrying to W.
+  const EkfSlam submap = SubmapOfWalls();
+  JoinedMap map;
+  map.mean = Eigen::Vector3d(3.0, -1.0, 0.7);
+  map.covariance = Eigen::Vector3d(0.04, 0.09, 0.01).asDiagonal();
+  map.covariance(0, 2) = map.covariance(2, 0) = 0.01;
+  int next_id = 0;
+  JoinedMap joined = map;
+  JoinSubmap(submap, LinkOf(map, {}), Params(), &joined, &next_id);
+  const SlamState& s = submap.slam_state();
+  for (int k = 0; k < 3; ++k) {
+    const FeatureType type = s.feature_type(k);
+    const auto to_world = [&](const Eigen::Matrix<double, 5, 1>& v) {
+      const Pose2 X_WB(v(0), v(1), v(2));
+      const Eigen::Vector2d f = v.tail<2>();
+      if (type == FeatureType::kCorner) return Eigen::Vector2d(X_WB * f);
+      // The line through two of its points, carried to W.
+      const Eigen::Vector2d n(std::cos(f.y()), std::sin(f.y()));
+      const Eigen::Vector2d t(-n.y(), n.x());
+      const Eigen::Vector2d a = X_WB * Eigen::Vector2d(f.x() * n);
+      const Eigen::Vector2d b = X_WB * Eigen::Vector2d(f.x() * n + t);
+      const Eigen::Vector2d d = (b - a).normalized();
+      const Eigen::Vector2d n_W(d.y(), -d.x());
+      return CanonicalLine(Eigen::Vector2d(n_W.dot(a), std::atan2(n_W.y(), n_W.x())));
+    };
+    Eigen::Matrix<double, 5, 1> v;
+    v << map.mean, s.feature(k);
+    const Eigen::Matrix<double, 2, 5> J = testing::NumericalJacobian<2, 5>(
+        to_world, v, type == FeatureType::kLine ? std::initializer_list<int>{1}
+                                                : std::initializer_list<int>{});
+    Eigen::Matrix<double, 5, 5> P = Eigen::Matrix<double, 5, 5>::Zero();
+    P.topLeftCorner<3, 3>() = map.covariance;
+    P.bottomRightCorner<2, 2>() = s.feature_covariance(k);
+    const Eigen::Matrix2d expected = J * P * J.transpose();
+    const Eigen::Matrix2d got = joined.covariance.block<2, 2>(3 + 2 * k, 3 + 2 * k);
+    EXPECT_NEAR((got - expected).norm(), 0.0, 1e-6 * expected.norm()) << "feature " << k;
+  }
 }
 
 TEST(JoinSubmapTest, FusesTheFeaturesASecondSubmapSeesAgain) {
