@@ -24,6 +24,11 @@ constexpr double kPi = 3.14159265358979323846;
 // keeps the batch's S positive definite when constraints are redundant.
 constexpr double kConstraintVariance = 1e-10;
 
+// The smallest eigenvalue of the shared part's prior covariance, scaled to a
+// unit diagonal, that its update uses: a smaller one is a function of the
+// other entries.
+constexpr double kMinSharedEigenvalue = 1e-9;
+
 // The variance the gate of a join adds to the first-order S of a pair's
 // difference: 1 mm (and 0.1 mrad), the order of a feature's error when
 // seen once.
@@ -196,12 +201,31 @@ struct SharedPart {
   // +1, or -1 on the r row of a line whose form flipped in the submap.
   Eigen::VectorXd sign;
   Eigen::MatrixXd D;
-  // P_CC^-1 over the rows, as an LDLT.
-  Eigen::LDLT<Eigen::MatrixXd> P_CC;
   // M = P_CC^-1 G P over the rows: all of the global map, or its first
   // three columns (the base).
   Eigen::MatrixXd M;
 };
+
+// P_CC^+ over `rows` of the link's P_CC: P_CC is singular where C holds a
+// function of its other entries (a corner of two shared lines); neither the
+// prior nor the submap can move that direction, so the pseudo-inverse leaves
+// it out. Scaled to a unit diagonal, so that the cut does not depend on units.
+Eigen::MatrixXd SharedPseudoInverse(const SubmapLink& link, const std::vector<int>& rows) {
+  const int na = static_cast<int>(rows.size());
+  Eigen::MatrixXd P_CC(na, na);
+  for (int i = 0; i < na; ++i) {
+    for (int j = 0; j < na; ++j) P_CC(i, j) = link.P_CC(rows[i], rows[j]);
+  }
+  const Eigen::VectorXd scale = P_CC.diagonal().cwiseSqrt().cwiseInverse();
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(scale.asDiagonal() * P_CC *
+                                                               scale.asDiagonal());
+  Eigen::VectorXd inverse = Eigen::VectorXd::Zero(na);
+  for (int i = 0; i < na; ++i) {
+    if (eigen.eigenvalues()(i) > kMinSharedEigenvalue) inverse(i) = 1.0 / eigen.eigenvalues()(i);
+  }
+  const Eigen::MatrixXd Q = scale.asDiagonal() * eigen.eigenvectors();
+  return Q * inverse.asDiagonal() * Q.transpose();
+}
 
 SharedPart SharedPartOf(const EkfSlam& submap, const SubmapLink& link, bool base_only) {
   SharedPart shared;
@@ -255,8 +279,12 @@ SharedPart SharedPartOf(const EkfSlam& submap, const SubmapLink& link, bool base
     }
   }
   shared.D = P_CC - P_new;
-  shared.P_CC.compute(P_CC);
-  shared.M = shared.P_CC.solve(GP);
+  // M = P_CC^+ G P, P_CC^+ computed once per set of rows.
+  if (link.pseudo_inverse_rows != shared.rows) {
+    link.pseudo_inverse = SharedPseudoInverse(link, shared.rows);
+    link.pseudo_inverse_rows = shared.rows;
+  }
+  shared.M = link.pseudo_inverse * GP;
   return shared;
 }
 

@@ -54,6 +54,10 @@ struct SubmapLink {
   std::vector<std::vector<std::pair<int, double>>> G;
   Eigen::MatrixXd GP;
   Eigen::MatrixXd P_CC;
+  /// A cache: the pseudo-inverse of P_CC over the rows the submap still
+  /// estimates (a shared line it removed as a duplicate drops out).
+  mutable std::vector<int> pseudo_inverse_rows;
+  mutable Eigen::MatrixXd pseudo_inverse;
 };
 
 /// The link of a submap that starts at `map`'s base sharing the
