@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
+#include <string>
 
 #include "common/check.h"
 
@@ -11,6 +13,9 @@ namespace {
 // Margin added around the covered box when the grid grows, metres: growing by
 // chunks keeps the number of reallocations small.
 constexpr double kGrowthMarginM = 2.0;
+// The most cells the grid grows to (400 MB of floats: 1 km x 1 km at 5 cm).
+// A scan seen from a pose estimate far beyond any building asks for more.
+constexpr double kMaxCells = 1e8;
 // Largest shortening of a beam's free part at grazing incidence, metres.
 constexpr double kMaxGrazingMarginM = 0.3;
 
@@ -46,6 +51,18 @@ void OccupancyGrid::EnsureCovers(const Eigen::Vector2d& lo, const Eigen::Vector2
     if (lo.x() >= origin.x() && lo.y() >= origin.y() && hi.x() < top.x() && hi.y() < top.y()) {
       return;
     }
+  }
+  const auto text = [](const Eigen::Vector2d& p) {
+    return "(" + std::to_string(p.x()) + ", " + std::to_string(p.y()) + ")";
+  };
+  const Eigen::Vector2d reach_lo = width > 0 ? lo.cwiseMin(origin) : lo;
+  const Eigen::Vector2d reach_hi = width > 0 ? hi.cwiseMax(limits_.far_corner()) : hi;
+  const Eigen::Vector2d extent = reach_hi - reach_lo;
+  if (!lo.allFinite() || !hi.allFinite() ||
+      (extent.x() / r + 1.0) * (extent.y() / r + 1.0) > kMaxCells) {
+    throw std::runtime_error("explorer: the occupancy grid cannot cover a scan from " + text(lo) +
+                             " to " + text(hi) + " (beyond " + std::to_string(kMaxCells) +
+                             " cells): the pose estimate it is driven from has left the world");
   }
   // New bounds on the existing cell lattice (origin moves by whole cells).
   Eigen::Vector2d new_lo = lo.array() - kGrowthMarginM;

@@ -1,5 +1,8 @@
 #include <cmath>
 
+#include <stdexcept>
+#include <string>
+
 #include <gtest/gtest.h>
 
 #include "explorer/occupancy_grid.h"
@@ -84,6 +87,25 @@ TEST(OccupancyGridTest, GrowsKeepingCellsInPlace) {
   EXPECT_EQ(grid.StateAt({2.0, 0.0}), CellState::kOccupied);
   EXPECT_EQ(grid.StateAt({1.0, 0.0}), CellState::kFree);
   EXPECT_EQ(grid.StateAt({-22.0, 5.0}), CellState::kOccupied);
+}
+
+TEST(OccupancyGridTest, ScanFromAPoseFarOutsideTheWorldIsAnErrorNotACrash) {
+  // A diverged estimate 1e9 m away, or NaN: the grid would need more cells
+  // than memory holds; it says so, and keeps what it has.
+  OccupancyGrid grid{ExplorerParams{}};
+  grid.InsertScan(UniformScan(181, 2.0, true, 30.0), Pose2(0.0, 0.0, 0.0));
+  const int width = grid.width();
+  try {
+    grid.InsertScan(UniformScan(181, 2.0, true, 30.0), Pose2(1e9, 0.0, 0.0));
+    FAIL() << "no error";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("has left the world"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(grid.InsertScan(UniformScan(181, 2.0, true, 30.0),
+                               Pose2(std::nan(""), 0.0, 0.0)),
+               std::runtime_error);
+  EXPECT_EQ(grid.width(), width);
+  EXPECT_EQ(grid.StateAt({2.0, 0.0}), CellState::kOccupied);
 }
 
 TEST(OccupancyGridTest, RoomWallsAreOccupiedAndInsideFree) {
