@@ -28,7 +28,7 @@ RULES = ("classical", "selective")
 
 
 def run_campaign(out, runs, duration):
-    command = [os.path.join(ROOT, "build", "mjslam"), "sweep", "--campaign",
+    command = [os.environ.get("MJSLAM", os.path.join(ROOT, "build", "mjslam")), "sweep", "--campaign",
                os.path.join(ROOT, "configs", "campaigns", "submap_sizes.yaml"),
                "--config", os.path.join(ROOT, "configs", "submaps.yaml"),
                "--set", "control.pose_source=ground_truth",
