@@ -478,8 +478,10 @@ void SceneRenderer::Impl::AddLayers(const SceneFrame& frame) {
     // Submap starts: a bar across the path, 16 pixels long.
     const FilterLayer& f = frame.filters[i];
     for (const Pose2& X_WR : f.submap_starts) {
-      const Eigen::Vector2d across = 8.0 * pixel_m * Eigen::Vector2d(-std::sin(X_WR.theta), std::cos(X_WR.theta));
-      AddSegment(X_WR.translation() - across, X_WR.translation() + across, kEllipseLayerZ, f.color, 3.0);
+      const Eigen::Vector2d across =
+          8.0 * pixel_m * Eigen::Vector2d(-std::sin(X_WR.theta), std::cos(X_WR.theta));
+      AddSegment(X_WR.translation() - across, X_WR.translation() + across, kEllipseLayerZ, f.color,
+                 3.0);
     }
   }
   for (const Eigen::Vector2d& p : frame.laser_hits) AddMarker(p, kHitLayerZ, 1.0 * pixel_m, colors::kLaserHits);

@@ -68,7 +68,9 @@ void SubmapFilter::StartSubmap(const SensorRecord* record,
                                     X_BW * PointOnLine(line_W, global_.segments[g].s_max));
       // The side seen from: the normal towards it is -side n.
       const double facing = global_.facing[g];
-      if (!std::isnan(facing)) f.seen_side = std::cos(facing - base(2) - f.params.y()) < 0.0 ? 1 : -1;
+      if (!std::isnan(facing)) {
+        f.seen_side = std::cos(facing - base(2) - f.params.y()) < 0.0 ? 1 : -1;
+      }
     }
     features.push_back(f);
   }
@@ -101,12 +103,12 @@ StepReport SubmapFilter::Step(const SensorRecord& record, const ScanFeatures* fe
       const int k = submap_->IndexOfId(ids_before[report.association.feature[i]]);
       if (k >= 0) seen[k] = true;
     }
-    const int last_id = ids_before.empty() ? -1 : *std::max_element(ids_before.begin(), ids_before.end());
+    const int last_id =
+        ids_before.empty() ? -1 : *std::max_element(ids_before.begin(), ids_before.end());
     for (int k = 0; k < submap_->num_features(); ++k) {
       if (submap_->id(k) > last_id) seen[k] = true;
     }
-    const JoinReport join =
-        JoinSubmap(*submap_, link_, params_, &global_, &next_id_);
+    const JoinReport join = JoinSubmap(*submap_, link_, params_, &global_, &next_id_);
     // The join runs beside the submap's filter (the robot goes on in the
     // new submap meanwhile): its cost is not the step's.
     std::vector<int> shared;

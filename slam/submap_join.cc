@@ -91,7 +91,8 @@ Transformed ToWorld(const SlamState& s, int nc, const std::vector<int>& features
     Eigen::Matrix2d Jf;
     Jf << 1.0, dr_dal, 0.0, 1.0;
     Eigen::Matrix2d C;
-    t.y.segment<2>(row) = CanonicalLine(Eigen::Vector2d(f.x() + base(0) * ca + base(1) * sa, al), &C);
+    const Eigen::Vector2d line_W(f.x() + base(0) * ca + base(1) * sa, al);
+    t.y.segment<2>(row) = CanonicalLine(line_W, &C);
     t.J_base.block<2, 3>(row, 0) = C * Jb;
     t.J_submap.block<2, 2>(row, row) = C * Jf;
   }

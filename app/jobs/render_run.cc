@@ -60,7 +60,8 @@ void ReadMap(const std::string& path, renders::FilterLayer* layer) {
 }
 
 // The value at `path` in `json` (null: none).
-const nlohmann::json* FindPath(const nlohmann::json& json, std::initializer_list<std::string> path) {
+const nlohmann::json* FindPath(const nlohmann::json& json,
+                               std::initializer_list<std::string> path) {
   const nlohmann::json* node = &json;
   for (const std::string& key : path) {
     if (!node->is_object() || !node->contains(key)) return nullptr;
