@@ -196,7 +196,7 @@ bool EkfSlam::SegmentsMeet(int k, const Observation& observation, const Pose2& X
   const LineSegment seen = SegmentFromPoints(state_.feature(k), X_WS * observation.p_SA,
                                              X_WS * observation.p_SB);
   const LineSegment& known = info_[k].segment;
-  return std::max(seen.s_min - known.s_max, known.s_min - seen.s_max) <= max_gap;
+  return SegmentGap(seen, known) <= max_gap;
 }
 
 double EkfSlam::SensorSideOfLine(int k) const {

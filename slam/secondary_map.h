@@ -37,6 +37,12 @@ inline LineSegment SegmentFromPoints(const Eigen::Vector2d& line_W, const Eigen:
   return {std::min(s_a, s_b), std::max(s_a, s_b)};
 }
 
+/// The gap between two segments of one line, metres: how far apart their
+/// nearest ends are (negative where they overlap).
+inline double SegmentGap(const LineSegment& a, const LineSegment& b) {
+  return std::max(a.s_min - b.s_max, b.s_min - a.s_max);
+}
+
 /// `segment` extended to cover the projections of p_WA and p_WB on the line
 /// (r, al): a wall seen further along grows its segment, never shrinks it.
 inline LineSegment ExtendSegment(const LineSegment& segment, const Eigen::Vector2d& line_W,

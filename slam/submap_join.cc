@@ -9,14 +9,13 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "common/angles.h"
 #include "common/check.h"
 #include "slam/data_association.h"
 #include "slam/observation_models.h"
 
 namespace mjslam::slam {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 // The variance of the identity constraint f_submap - f_global = 0 that fuses
 // a matched pair (metres^2, radians^2): far below any feature's, it only
@@ -113,14 +112,9 @@ Eigen::Vector2d Difference(FeatureType type, const Eigen::Vector2d& f_a,
                            const Eigen::Vector2d& f_b, Eigen::Matrix2d* A) {
   A->setIdentity();
   if (type == FeatureType::kCorner) return f_a - f_b;
-  double dal = WrapAngle(f_a.y() - f_b.y());
-  double r_a = f_a.x();
-  if (std::abs(dal) > kPi / 2) {
-    (*A)(0, 0) = -1.0;
-    r_a = -r_a;
-    dal = WrapAngle(dal + kPi);
-  }
-  return {r_a - f_b.x(), dal};
+  Eigen::Vector2d aligned = f_a;
+  if (AlignLineToObservation(f_b, &aligned)) (*A)(0, 0) = -1.0;
+  return -Innovation(f_b, aligned);
 }
 
 // Whether the seen segments of lines a and b (in W) are within `max_gap`
@@ -130,7 +124,7 @@ bool SegmentsMeet(const Eigen::Vector2d& line_a, const LineSegment& seg_a,
   if (max_gap <= 0.0) return true;
   const LineSegment a_on_b = SegmentFromPoints(line_b, PointOnLine(line_a, seg_a.s_min),
                                                PointOnLine(line_a, seg_a.s_max));
-  return std::max(a_on_b.s_min - seg_b.s_max, seg_b.s_min - a_on_b.s_max) <= max_gap;
+  return SegmentGap(a_on_b, seg_b) <= max_gap;
 }
 
 }  // namespace
