@@ -17,21 +17,24 @@
 namespace mjslam::slam {
 namespace {
 
-// The variance of the identity constraint f_submap - f_global = 0 that fuses
-// a matched pair (metres^2, radians^2): far below any feature's, it only
-// keeps the batch's S positive definite when constraints are redundant.
-constexpr double kConstraintVariance = 1e-10;
-
 // The smallest eigenvalue of the shared part's prior covariance, scaled to a
 // unit diagonal, that its update uses: a smaller one is a function of the
 // other entries.
 constexpr double kMinSharedEigenvalue = 1e-9;
 
-// The variance the gate of a join adds to the first-order S of a pair's
-// difference: 1 mm (and 0.1 mrad), the order of a feature's error when
-// seen once.
+// The variance a join adds to the first-order S of a pair's difference, in
+// its gate and in its fusion: 1 mm (and 0.1 mrad), the order of a feature's
+// error when seen once. The first-order S misses the linearisation's residue,
+// which matters where the two copies are nearly one function of the same
+// entries (a corner of two shared lines, a wall the submap saw only through
+// its shared part): there S is near 0, and a hard constraint would turn a
+// residue of micrometres into a correction of many standard deviations.
 const Eigen::Vector2d kLineResidue(1e-6, 1e-8);
 const Eigen::Vector2d kCornerResidue(1e-6, 1e-6);
+
+const Eigen::Vector2d& Residue(FeatureType type) {
+  return type == FeatureType::kLine ? kLineResidue : kCornerResidue;
+}
 
 // The quantities a join carries to W, y = [x_B', c, f_k...] of the submap
 // (c: its nc self-calibration entries as they are now; f_k its features
@@ -428,10 +431,7 @@ JoinReport JoinSubmap(const EkfSlam& submap, const SubmapLink& link, const EkfPa
       const Eigen::Matrix2d P_ab = P.block<2, 2>(ia, ib);
       Eigen::Matrix2d S = A * P_aa * A.transpose() + P.block<2, 2>(ib, ib) - A * P_ab -
                           P_ab.transpose() * A.transpose();
-      // The first-order S misses the linearisation's residue, which matters
-      // where the two are nearly one function of the same entries (a corner
-      // of two shared lines).
-      S += (map->types[a] == FeatureType::kLine ? kLineResidue : kCornerResidue).asDiagonal();
+      S += Residue(map->types[a]).asDiagonal();
       const double d2 = d.dot(S.ldlt().solve(d));
       if (d2 < gate) pairs.emplace_back(d2, a, b);
     }
@@ -473,12 +473,16 @@ JoinReport JoinSubmap(const EkfSlam& submap, const SubmapLink& link, const EkfPa
           As[i] * PHt.middleRows<2>(index(a)) - PHt.middleRows<2>(index(b));
     }
     S = 0.5 * (S + S.transpose()).eval();
-    // A hard constraint: S + sigma^2 I = W^-T W^-1, its eigenvalues clamped
-    // at 0 first (round-off can leave one a little below where constraints
-    // are redundant: a corner made from two lines that match too).
+    // Each constraint with the gate's residue: S = W^-T W^-1, its eigenvalues
+    // kept at or above the smallest residue (round-off can leave one below
+    // where constraints are redundant: a corner made from two lines that
+    // match too).
+    for (int i = 0; i < m; ++i) {
+      S.block<2, 2>(2 * i, 2 * i) += Residue(map->types[matches[i].first]).asDiagonal();
+    }
     const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(S);
     const Eigen::VectorXd inverse_sqrt =
-        (eigen.eigenvalues().cwiseMax(0.0).array() + kConstraintVariance).rsqrt();
+        eigen.eigenvalues().cwiseMax(kLineResidue.minCoeff()).array().rsqrt();
     const Eigen::MatrixXd W = eigen.eigenvectors() * inverse_sqrt.asDiagonal();  // S^-1 = W W^T
     // K nu = V W^T nu and P <- P - V V^T, with V = P H^T W.
     const Eigen::MatrixXd V = PHt * W;

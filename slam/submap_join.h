@@ -89,7 +89,8 @@ struct JoinReport {
 /// the same side with seen segments within `params.line_match_max_gap_m`; a
 /// global feature may take several, a wall the submap mapped in pieces), the
 /// pairs are fused by one batch EKF update with the identity constraint
-/// f_submap - f_global = 0, and the submap's copies removed. New features
+/// f_submap - f_global = 0 (its noise the gate's linearisation residue), and
+/// the submap's copies removed. New features
 /// take ids from *next_id.
 JoinReport JoinSubmap(const EkfSlam& submap, const SubmapLink& link, const EkfParams& params,
                       JoinedMap* map, int* next_id);

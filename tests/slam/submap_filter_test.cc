@@ -137,9 +137,14 @@ TEST(JoinSubmapTest, FusesTheFeaturesASecondSubmapSeesAgain) {
   EXPECT_EQ(report.num_new, 0);
   EXPECT_EQ(map.num_features(), 3);
   EXPECT_EQ(next_id, 3);
-  // Two independent looks at a wall from an exact pose: half the variance.
-  EXPECT_NEAR(map.covariance(3, 3), 0.5 * P_first(0, 0), 1e-3 * P_first(0, 0));
-  EXPECT_NEAR(map.covariance(4, 4), 0.5 * P_first(1, 1), 1e-3 * P_first(1, 1));
+  // Two independent looks at a wall from an exact pose: half the variance,
+  // fused with the join's residue of (1 mm, 0.1 mrad)^2 as the noise of
+  // their difference: P - P (2 P + R)^-1 P.
+  const Eigen::Matrix2d R = Eigen::Vector2d(1e-6, 1e-8).asDiagonal();
+  const Eigen::Matrix2d expected = P_first - P_first * (2.0 * P_first + R).inverse() * P_first;
+  EXPECT_NEAR(map.covariance(3, 3), expected(0, 0), 1e-6 * P_first(0, 0));
+  EXPECT_NEAR(map.covariance(4, 4), expected(1, 1), 1e-6 * P_first(1, 1));
+  EXPECT_GT(map.covariance(3, 3), 0.5 * P_first(0, 0));
 }
 
 TEST(JoinSubmapTest, AWallSeenFromItsOtherSideIsNotFused) {
