@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
+#include <string>
 
 #include <Eigen/Cholesky>
 
@@ -136,6 +138,27 @@ MapMatchReport MatchMaps(const Map& estimate, const Map& truth, const MatchParam
   report.line_alpha_rmse_rad = num_lines > 0 ? std::sqrt(alpha_sq / num_lines) : kNaN;
   report.corner_rmse_m = num_corners > 0 ? std::sqrt(corner_sq / num_corners) : kNaN;
   return report;
+}
+
+SeenMatch MatchedSeen(const MapMatchReport& report, const std::vector<char>& seen) {
+  if (static_cast<int>(seen.size()) != report.num_truth) {
+    throw std::invalid_argument("MatchedSeen: " + std::to_string(seen.size()) +
+                                " seen flags for " + std::to_string(report.num_truth) +
+                                " true features");
+  }
+  std::vector<char> matched(seen.size(), 0);
+  for (const int t : report.truth_index) {
+    if (t >= 0) matched[t] = 1;
+  }
+  SeenMatch result;
+  int both = 0;
+  for (std::size_t t = 0; t < seen.size(); ++t) {
+    if (seen[t] == 0) continue;
+    ++result.seen;
+    if (matched[t] != 0) ++both;
+  }
+  if (result.seen > 0) result.matched_fraction = static_cast<double>(both) / result.seen;
+  return result;
 }
 
 }  // namespace mjslam::eval

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <limits>
 #include <vector>
 
 #include "common/params.h"
@@ -68,5 +69,17 @@ struct MapMatchReport {
 /// true line ((r, al) and (-r, al + pi)), so lines through W's origin match.
 /// Throws ParamError for invalid params.
 MapMatchReport MatchMaps(const Map& estimate, const Map& truth, const MatchParams& params = {});
+
+/// The true features a run saw and how many of them a map matched.
+struct SeenMatch {
+  int seen = 0;
+  /// Seen true features with a matched estimate / seen (NaN when none is).
+  double matched_fraction = std::numeric_limits<double>::quiet_NaN();
+};
+
+/// SeenMatch of `report` (MatchMaps against the truth) given `seen`, one
+/// entry per true feature, nonzero where the run saw it. Throws
+/// std::invalid_argument when the sizes differ.
+SeenMatch MatchedSeen(const MapMatchReport& report, const std::vector<char>& seen);
 
 }  // namespace mjslam::eval

@@ -57,6 +57,7 @@ constexpr FilterColumn kFilterColumns[] = {
     {"rmse_y", "/runs_mean/rmse/y"},
     {"rmse_th", "/runs_mean/rmse/th"},
     {"matched_fraction", "/runs_mean/map/matched_fraction"},
+    {"matched_seen_fraction", "/runs_mean/map/matched_seen_fraction"},
     {"processing_s", "/processing_s"}};
 
 }  // namespace

@@ -596,7 +596,8 @@ nlohmann::json FilterAggregate(std::size_t f, const SweepRuns& runs, const NeesC
     }
   }
   for (const char* key : {"num_estimates", "num_truth", "matched_estimates", "matched_truth",
-                          "matched_fraction", "duplicates", "unmatched_estimates",
+                          "matched_fraction", "seen_truth", "matched_seen_fraction",
+                          "duplicates", "unmatched_estimates",
                           "inconsistent", "mean_feature_nees", "line_rho_rmse_m",
                           "line_alpha_rmse_rad", "corner_rmse_m"}) {
     j["runs_mean"]["map"][key] =

@@ -245,11 +245,14 @@ RunEvaluation EvaluateRunDirectory(const std::string& run_dir, const EvaluateOpt
     f["mean_nees"] = Number(pose.mean_nees);
     f["final_pose_error"] = Xyz(pose.final_error);
     f["num_features"] = static_cast<int>(maps[i].size());
+    const eval::SeenMatch seen = eval::MatchedSeen(map, result.observations.seen);
     f["map"] = {{"num_estimates", map.num_estimates},
                 {"num_truth", map.num_truth},
                 {"matched_estimates", map.num_matched_estimates},
                 {"matched_truth", map.num_matched_truth},
                 {"matched_fraction", map.matched_fraction},
+                {"seen_truth", seen.seen},
+                {"matched_seen_fraction", Number(seen.matched_fraction)},
                 {"duplicates", map.num_duplicates},
                 {"unmatched_estimates", map.num_unmatched_estimates},
                 {"inconsistent", map.num_inconsistent},

@@ -55,10 +55,12 @@ const MapFeature* TrueLineOf(const eval::Map& truth, const Eigen::Vector2d& A,
 }  // namespace
 
 ObservationCheck CheckLineObservations(const std::string& scans_path, const RunConfig& config,
-                                       const eval::Map& truth, double max_distance_m) {
+                                       const eval::Map& truth, double max_distance_m,
+                                       double max_corner_distance_m) {
   const std::vector<rundir::ScanRow> scans = rundir::ReadScanRows(scans_path);
   const int num_beams = config.laser.num_beams;
   ObservationCheck check;
+  check.seen.assign(truth.size(), 0);
   std::vector<Residual> residuals;
   LaserScan scan;
   scan.angle_min_rad = config.laser.AngleMinRad();
@@ -87,6 +89,7 @@ ObservationCheck CheckLineObservations(const std::string& scans_path, const RunC
           TrueLineOf(truth, X_WS * line.p_SA, X_WS * line.p_SB, max_distance_m);
       if (wall == nullptr) continue;
       ++check.matched;
+      check.seen[wall - truth.data()] = 1;
       // The true line seen from X_WS, in the observation's polar form.
       const double r = wall->params.x();
       const double alpha = wall->params.y();
@@ -101,6 +104,20 @@ ObservationCheck CheckLineObservations(const std::string& scans_path, const RunC
       residual.R_inverse = line.covariance.inverse();
       residual.g = line.range_bias_gradient;
       residuals.push_back(residual);
+    }
+    for (const slam::CornerObservation& corner : features.corners) {
+      const Eigen::Vector2d p = X_WS * corner.p_SC;
+      double best = max_corner_distance_m;
+      int nearest = -1;
+      for (std::size_t k = 0; k < truth.size(); ++k) {
+        if (truth[k].type != FeatureType::kCorner) continue;
+        const double distance = (truth[k].params - p).norm();
+        if (distance <= best) {
+          best = distance;
+          nearest = static_cast<int>(k);
+        }
+      }
+      if (nearest >= 0) check.seen[nearest] = 1;
     }
   }
   if (residuals.empty()) return check;

@@ -6,6 +6,7 @@
 
 #include <limits>
 #include <string>
+#include <vector>
 
 #include "app/engine/run_config.h"
 #include "eval/map_types.h"
@@ -26,6 +27,10 @@ struct ObservationCheck {
   double mean_nis = std::numeric_limits<double>::quiet_NaN();
   double fraction_above_gate = std::numeric_limits<double>::quiet_NaN();
   double max_nis = std::numeric_limits<double>::quiet_NaN();
+  /// For each feature of the truth, whether the laser saw it: a line that an
+  /// extracted line lay on, a corner within `max_corner_distance_m` of an
+  /// extracted corner (1), or not (0).
+  std::vector<char> seen;
 };
 
 /// Re-extracts every scan of `scans_path` (scans.csv of a simulated run) with
@@ -36,8 +41,11 @@ struct ObservationCheck {
 /// segment); then compares each matched observation z, covariance R, with
 /// the true line seen from the true pose: NIS = nu^T R^-1 nu, nu = z - h_true
 /// - g b, g the observation's range-bias gradient and b the run's estimated
-/// range bias. Throws std::runtime_error naming the file on bad input.
+/// range bias. Every extracted corner placed the same way marks the nearest
+/// true corner within `max_corner_distance_m` seen. Throws
+/// std::runtime_error naming the file on bad input.
 ObservationCheck CheckLineObservations(const std::string& scans_path, const RunConfig& config,
-                                       const eval::Map& truth, double max_distance_m = 0.05);
+                                       const eval::Map& truth, double max_distance_m = 0.05,
+                                       double max_corner_distance_m = 0.15);
 
 }  // namespace mjslam::app

@@ -157,6 +157,19 @@ TEST(MapMatchingTest, CountsMatchesDuplicatesUnmatchedAndInconsistent) {
   EXPECT_NEAR(r.corner_rmse_m, 0.03, 1e-12);
 }
 
+TEST(MapMatchingTest, MatchedSeenCountsOnlyTheTruthTheRunSaw) {
+  // The truth of the test above; the run saw the first line, the line x = 4
+  // and the first corner. The estimates match truth 0 (twice), 1 and 3.
+  MapMatchReport r;
+  r.num_truth = 5;
+  r.truth_index = {0, 0, 1, -1, 3, -1};
+  const SeenMatch m = MatchedSeen(r, {1, 0, 1, 1, 0});
+  EXPECT_EQ(m.seen, 3);
+  EXPECT_NEAR(m.matched_fraction, 2.0 / 3.0, 1e-12);  // truth 0 and 3, not 2
+  EXPECT_TRUE(std::isnan(MatchedSeen(r, {0, 0, 0, 0, 0}).matched_fraction));
+  EXPECT_THROW(MatchedSeen(r, {1, 1}), std::invalid_argument);
+}
+
 TEST(MapMatchingTest, LinesThroughTheOriginMatchInEitherPolarForm) {
   // The line y = 0 seen as (0, pi/2) and estimated as (0.001, -pi/2 + 0.002).
   const Map truth = {Line(0.0, kPi / 2, {-1, 0}, {1, 0})};

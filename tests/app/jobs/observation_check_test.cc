@@ -80,6 +80,18 @@ TEST(ObservationCheckTest, StraightWallsWithTheModelledNoiseHaveChiSquareNis) {
   fs::remove_all(fs::path(path).parent_path());
 }
 
+TEST(ObservationCheckTest, MarksSeenTheTrueFeaturesTheScansShow) {
+  const std::string path = WriteScans("seen", 20, 0.0);
+  // The wall the laser sees; one behind it; a corner out of its view.
+  MapFeature corner;
+  corner.type = FeatureType::kCorner;
+  corner.params = Eigen::Vector2d(-3.0, 2.0);
+  const eval::Map truth = {Wall(2.0, -2.0, 3.5), Wall(-3.0, -2.0, 2.0), corner};
+  const ObservationCheck check = CheckLineObservations(path, RunConfig{}, truth);
+  EXPECT_EQ(check.seen, (std::vector<char>{1, 0, 0}));
+  fs::remove_all(fs::path(path).parent_path());
+}
+
 TEST(ObservationCheckTest, AStepBetweenParallelWallsIsSplitByTheFitTest) {
   const std::string path = WriteScans("step", 100, 0.05);
   const eval::Map truth = {Wall(2.0, -2.0, 2.0), Wall(2.05, 2.05, 3.6)};
