@@ -63,6 +63,9 @@ struct StepReport {
   /// step's corrections of n^2, n the size of the state each one updated.
   /// Negative (EkfSlam): num_updated (3 + 2 num_features)^2.
   double correction_cost_n2 = -1.0;
+  /// Microseconds of the step spent on work that runs beside the filter (a
+  /// submap's join): left out of its measured processing time.
+  double beside_us = 0.0;
   /// What became of each observation (lines first, then corners, as the
   /// features were extracted), for diagnostics: its outcome and matched
   /// feature (an index into the map before this step's duplicate lines were

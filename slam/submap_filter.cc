@@ -1,6 +1,7 @@
 #include "slam/submap_filter.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <string>
 #include <utility>
@@ -108,6 +109,7 @@ StepReport SubmapFilter::Step(const SensorRecord& record, const ScanFeatures* fe
     for (int k = 0; k < submap_->num_features(); ++k) {
       if (submap_->id(k) > last_id) seen[k] = true;
     }
+    const auto join_start = std::chrono::steady_clock::now();
     const JoinReport join = JoinSubmap(*submap_, link_, params_, &global_, &next_id_);
     // The join runs beside the submap's filter (the robot goes on in the
     // new submap meanwhile): its cost is not the step's.
@@ -120,6 +122,9 @@ StepReport SubmapFilter::Step(const SensorRecord& record, const ScanFeatures* fe
     ++num_joins_;
     start_times_.push_back(record.t_s);
     StartSubmap(&record, shared);
+    report.beside_us = std::chrono::duration<double, std::micro>(
+                           std::chrono::steady_clock::now() - join_start)
+                           .count();
   }
   report.num_features = num_features();
   return report;

@@ -71,7 +71,8 @@ void FilterBank::Step(const SensorRecord& record) {
       const slam::ScanFeatures* given = record.has_scan ? &features : nullptr;
       f.report = f.timing == FilterTiming::kEveryScan ? f.filter->Step(record, given)
                                                       : CatchUpAndStep(&f, step, record, given);
-      f.processing_us = extraction_us + MicrosecondsSince(start);
+      // A submap's join runs beside the filter: not in its processing time.
+      f.processing_us = extraction_us + MicrosecondsSince(start) - f.report.beside_us;
       f.processing_s = ProcessingSeconds(control_, f.report, record.has_scan, f.processing_us);
       f.period_steps = CommandPeriodSteps(f.processing_s, dt_s_);
       f.total_processing_s += f.processing_s;
