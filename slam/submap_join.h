@@ -90,8 +90,7 @@ struct JoinReport {
 /// global feature may take several, a wall the submap mapped in pieces), the
 /// pairs are fused by one batch EKF update with the identity constraint
 /// f_submap - f_global = 0 (its noise the gate's linearisation residue), and
-/// the submap's copies removed. New features
-/// take ids from *next_id.
+/// the submap's copies removed. New features take ids from *next_id.
 JoinReport JoinSubmap(const EkfSlam& submap, const SubmapLink& link, const EkfParams& params,
                       JoinedMap* map, int* next_id);
 

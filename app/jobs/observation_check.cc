@@ -61,6 +61,10 @@ ObservationCheck CheckLineObservations(const std::string& scans_path, const RunC
   const int num_beams = config.laser.num_beams;
   ObservationCheck check;
   check.seen.assign(truth.size(), 0);
+  std::vector<int> true_corners;
+  for (std::size_t k = 0; k < truth.size(); ++k) {
+    if (truth[k].type == FeatureType::kCorner) true_corners.push_back(static_cast<int>(k));
+  }
   std::vector<Residual> residuals;
   LaserScan scan;
   scan.angle_min_rad = config.laser.AngleMinRad();
@@ -109,12 +113,11 @@ ObservationCheck CheckLineObservations(const std::string& scans_path, const RunC
       const Eigen::Vector2d p = X_WS * corner.p_SC;
       double best = max_corner_distance_m;
       int nearest = -1;
-      for (std::size_t k = 0; k < truth.size(); ++k) {
-        if (truth[k].type != FeatureType::kCorner) continue;
+      for (const int k : true_corners) {
         const double distance = (truth[k].params - p).norm();
         if (distance <= best) {
           best = distance;
-          nearest = static_cast<int>(k);
+          nearest = k;
         }
       }
       if (nearest >= 0) check.seen[nearest] = 1;

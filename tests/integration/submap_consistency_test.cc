@@ -5,8 +5,7 @@
 // configs/default.yaml (seeds 1..10, submaps of 30 features, so that every
 // run joins several submaps and closes its loop through a join), and in the
 // 40 x 30 m building of configs/submaps.yaml (seeds 201..210, submaps of 40,
-// every scan, 1000 s: 9-12 joins a run, most of them re-entering mapped
-// rooms).
+// every scan, 1000 s: about 10 joins a run).
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -70,7 +69,7 @@ TEST(SubmapConsistencyTest, BothRulesInSubmapsHoldInTheCorridor) {
   }
 }
 
-// Joins that re-enter mapped rooms keep both rules consistent in a building:
+// Joins keep both rules consistent in a building:
 // ANEES inside its bounds for >= 85 % of the steps, above the upper bound
 // for <= 5 %. Measured: inside 0.977 / 0.930, above 0.001 / 0.001 (classical
 // / selective). With the matched pairs fused as hard constraints (variance
