@@ -282,7 +282,7 @@ std::vector<Explorer::Candidate> Explorer::ScoreFrontiers(
   // The points with gain that are not blacklisted (no search needed).
   std::vector<Candidate> pending;
   for (const Eigen::Vector2d& p : points) {
-    const double gain = InformationGain(grid_, p, params_.gain_radius_m);
+    const double gain = gains_.Gain(grid_, p, params_.gain_radius_m);
     if (gain < params_.min_gain_m2) continue;
     bool failed = false;
     int looks = 0;

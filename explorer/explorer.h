@@ -11,6 +11,7 @@
 #include "common/records.h"
 #include "explorer/clearance_field.h"
 #include "explorer/explorer_params.h"
+#include "explorer/frontiers.h"
 #include "explorer/occupancy_grid.h"
 #include "explorer/path_planner.h"
 #include "explorer/path_tracker.h"
@@ -215,6 +216,8 @@ class Explorer {
   OccupancyGrid grid_;
   // The grid's clearance, brought up to date before each NavigationMap.
   ClearanceField clearance_;
+  // The gains of frontier points scored before.
+  GainCache gains_;
   PathTracker tracker_;
   Phase phase_ = Phase::kInitialTurn;
 

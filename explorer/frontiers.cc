@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <limits>
 
 #include "common/angles.h"
+#include "common/check.h"
 #include "common/grid2.h"
 
 namespace mjslam::explorer {
@@ -186,6 +188,38 @@ double InformationGain(const OccupancyGrid& grid, const Eigen::Vector2d& p_W, do
 bool HasInformationGain(const OccupancyGrid& grid, const Eigen::Vector2d& p_W, double radius_m,
                         double min_gain_m2) {
   return CountGain(grid, p_W, radius_m, min_gain_m2) >= min_gain_m2;
+}
+
+double GainCache::Gain(const OccupancyGrid& grid, const Eigen::Vector2d& p_W, double radius_m) {
+  MJSLAM_CHECK(radius_m_ < 0.0 || radius_m_ == radius_m);
+  radius_m_ = radius_m;
+  const std::vector<OccupancyGrid::LatticeBox>& changes = grid.state_changes();
+  std::pair<std::uint64_t, std::uint64_t> key;
+  std::memcpy(&key.first, &p_W.x(), sizeof(double));
+  std::memcpy(&key.second, &p_W.y(), sizeof(double));
+  const auto it = entries_.find(key);
+  if (it != entries_.end()) {
+    Entry& entry = it->second;
+    bool changed = false;
+    for (std::size_t k = entry.changes_checked; k < changes.size() && !changed; ++k) {
+      changed = (changes[k].lo.array() <= entry.reads.hi.array()).all() &&
+                (entry.reads.lo.array() <= changes[k].hi.array()).all();
+    }
+    if (!changed) {
+      entry.changes_checked = changes.size();
+      return entry.gain_m2;
+    }
+  }
+  // CountGain reads the cells within its box's reach of the point's cell
+  // and, through BlocksRay, one more.
+  const int reach = static_cast<int>(std::ceil(radius_m / grid.resolution())) + 3;
+  const Eigen::Vector2i center = grid.CellOf(p_W) + grid.lattice_origin();
+  const double gain = InformationGain(grid, p_W, radius_m);
+  entries_[key] = Entry{gain,
+                        {center - Eigen::Vector2i::Constant(reach),
+                         center + Eigen::Vector2i::Constant(reach)},
+                        changes.size()};
+  return gain;
 }
 
 }  // namespace mjslam::explorer

@@ -1,5 +1,10 @@
 #pragma once
 
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <unordered_map>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
@@ -45,5 +50,34 @@ double InformationGain(const OccupancyGrid& grid, const Eigen::Vector2d& p_W, do
 /// gain, the common case, costs a fraction of the full count).
 bool HasInformationGain(const OccupancyGrid& grid, const Eigen::Vector2d& p_W, double radius_m,
                         double min_gain_m2);
+
+/// InformationGain with memory, for points scored again and again (the
+/// global frontier points, at every choice of a goal): a point's gain is
+/// kept and given again while no cell its count reads has changed state
+/// since (OccupancyGrid::state_changes), the same value, bit for bit, as
+/// InformationGain. Made for one grid and one radius.
+class GainCache {
+ public:
+  /// InformationGain(grid, p_W, radius_m); `grid` and `radius_m` the same
+  /// at every call.
+  double Gain(const OccupancyGrid& grid, const Eigen::Vector2d& p_W, double radius_m);
+
+ private:
+  // A point's gain, the lattice box of the cells its count reads, and how
+  // many of the grid's state changes the entry has been checked against.
+  struct Entry {
+    double gain_m2;
+    OccupancyGrid::LatticeBox reads;
+    std::size_t changes_checked;
+  };
+  // Points by the bits of their coordinates.
+  struct PointHash {
+    std::size_t operator()(const std::pair<std::uint64_t, std::uint64_t>& key) const {
+      return std::hash<std::uint64_t>()(key.first * 0x9E3779B97F4A7C15ULL ^ key.second);
+    }
+  };
+  std::unordered_map<std::pair<std::uint64_t, std::uint64_t>, Entry, PointHash> entries_;
+  double radius_m_ = -1.0;
+};
 
 }  // namespace mjslam::explorer

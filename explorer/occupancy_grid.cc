@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -114,18 +115,27 @@ void OccupancyGrid::MarkRayFree(const Eigen::Vector2d& from, const Eigen::Vector
 }
 
 void OccupancyGrid::ApplyMarks() {
+  // The box of the cells whose state changes (empty while lo > hi).
+  LatticeBox changed{Eigen::Vector2i::Constant(std::numeric_limits<int>::max()),
+                     Eigen::Vector2i::Constant(std::numeric_limits<int>::min())};
   for (const int i : touched_) {
     const double delta = marks_[i] == 2 ? params_.log_odds_hit : params_.log_odds_miss;
-    const bool was_occupied = log_odds_[i] >= params_.occupied_threshold;
+    const CellState was = StateOfLogOdds(log_odds_[i]);
     log_odds_[i] = static_cast<float>(std::clamp(log_odds_[i] + delta, params_.log_odds_min,
                                                  params_.log_odds_max));
     marks_[i] = 0;
+    const CellState is = StateOfLogOdds(log_odds_[i]);
+    if (is == was) continue;
+    const Eigen::Vector2i lattice = limits_.CellOfIndex(i) + lattice_origin_;
+    changed.lo = changed.lo.cwiseMin(lattice);
+    changed.hi = changed.hi.cwiseMax(lattice);
     // The log of occupancy changes (read by ClearanceField).
-    if ((log_odds_[i] >= params_.occupied_threshold) != was_occupied) {
-      occupancy_changes_.push_back(limits_.CellOfIndex(i) + lattice_origin_);
+    if ((is == CellState::kOccupied) != (was == CellState::kOccupied)) {
+      occupancy_changes_.push_back(lattice);
     }
   }
   touched_.clear();
+  if (changed.lo.x() <= changed.hi.x()) state_changes_.push_back(changed);
 }
 
 OccupancyGrid::BeamFreeSpace OccupancyGrid::FreeSpaceOfBeams(const LaserScan& scan) const {

@@ -67,11 +67,7 @@ class OccupancyGrid {
   double LogOdds(int ix, int iy) const;
   /// State of a cell from the thresholds; unknown outside the grid.
   CellState State(int ix, int iy) const {
-    if (!Contains(ix, iy)) return CellState::kUnknown;
-    const double l = log_odds_[Index(ix, iy)];
-    if (l >= params_.occupied_threshold) return CellState::kOccupied;
-    if (l <= params_.free_threshold) return CellState::kFree;
-    return CellState::kUnknown;
+    return Contains(ix, iy) ? StateOfLogOdds(log_odds_[Index(ix, iy)]) : CellState::kUnknown;
   }
   /// State of the cell containing `p_W`.
   CellState StateAt(const Eigen::Vector2d& p_W) const;
@@ -89,6 +85,17 @@ class OccupancyGrid {
   /// entries it has read (ClearanceField does).
   const std::vector<Eigen::Vector2i>& occupancy_changes() const { return occupancy_changes_; }
 
+  /// A box of lattice cells, both corners included.
+  struct LatticeBox {
+    Eigen::Vector2i lo;
+    Eigen::Vector2i hi;
+  };
+  /// For every insertion (a scan, a rectangle) that changed the State of a
+  /// cell, the lattice box of the cells it changed, in order. Append-only,
+  /// like occupancy_changes(): a reader (GainCache) remembers how many
+  /// entries it has read.
+  const std::vector<LatticeBox>& state_changes() const { return state_changes_; }
+
  private:
   // Per beam of a scan: the range up to which it proves free space, and
   // whether it ends on an echo that is inserted as occupied.
@@ -97,6 +104,12 @@ class OccupancyGrid {
     std::vector<std::uint8_t> hit;
   };
 
+  // The state of a cell of log-odds `l` (the thresholds).
+  CellState StateOfLogOdds(double l) const {
+    if (l >= params_.occupied_threshold) return CellState::kOccupied;
+    if (l <= params_.free_threshold) return CellState::kFree;
+    return CellState::kUnknown;
+  }
   // The free range and echo flag of every beam of `scan`.
   BeamFreeSpace FreeSpaceOfBeams(const LaserScan& scan) const;
   // Grows the grid to cover every point the scan touches (its echoes and
@@ -127,6 +140,7 @@ class OccupancyGrid {
   std::vector<int> touched_;
   Eigen::Vector2i lattice_origin_ = Eigen::Vector2i::Zero();
   std::vector<Eigen::Vector2i> occupancy_changes_;
+  std::vector<LatticeBox> state_changes_;
 };
 
 }  // namespace mjslam::explorer

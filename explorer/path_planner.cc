@@ -68,6 +68,8 @@ void AppendSegment(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double st
 
 }  // namespace
 
+thread_local std::vector<std::unique_ptr<NavigationMap::NodeTable>> NavigationMap::spare_tables_;
+
 double ClearanceCapM(const ExplorerParams& params) {
   return std::max(params.preferred_clearance_m, params.clearance_m);
 }
@@ -100,7 +102,24 @@ NavigationMap::NavigationMap(const OccupancyGrid& grid, const ClearanceField& cl
   Start(search);
 }
 
+NavigationMap::~NavigationMap() { spare_tables_.push_back(std::move(table_)); }
+
 void NavigationMap::Start(Search search) {
+  // A table of the thread's spares (a new one when none is left), with
+  // room for every cell and a stamp no entry has yet.
+  if (spare_tables_.empty()) {
+    table_ = std::make_unique<NodeTable>();
+  } else {
+    table_ = std::move(spare_tables_.back());
+    spare_tables_.pop_back();
+  }
+  const std::size_t cells = static_cast<std::size_t>(grid_.width()) * grid_.height();
+  if (table_->nodes.size() < cells) table_->nodes.resize(cells, Node{0.0f, -1, 0, false, 0});
+  if (table_->last_stamp == std::numeric_limits<std::uint32_t>::max()) {
+    for (Node& node : table_->nodes) node.stamp = 0;
+    table_->last_stamp = 0;
+  }
+  stamp_ = ++table_->last_stamp;
   // Nothing to search from a start outside the grid: every cost infinite.
   if (!grid_.Contains(start_.x(), start_.y())) {
     expanded_cost_m_ = kInfinity;
@@ -109,7 +128,7 @@ void NavigationMap::Start(Search search) {
   escape_ = !Comfortable(start_.x(), start_.y());
   start_clearance_ = (*clearance_)[grid_.Index(start_.x(), start_.y())];
   const int start_index = grid_.Index(start_.x(), start_.y());
-  nodes_[start_index] = Node{0.0f, -1, false};
+  Reach(start_index).cost = 0.0f;
   open_.push_back({0.0, 0.0f, start_index});
   if (search == Search::kFull) ExpandTo(kInfinity);
 }
@@ -141,7 +160,7 @@ bool NavigationMap::SettleNext(int goal) {
     std::pop_heap(open_.begin(), open_.end(), std::greater<Open>());
     const Open top = open_.back();
     open_.pop_back();
-    Node& node = nodes_.at(top.index);
+    Node& node = table_->nodes[top.index];
     if (node.settled || top.cost > node.cost) continue;  // stale entry
     node.settled = true;
     ++settled_;
@@ -152,16 +171,17 @@ bool NavigationMap::SettleNext(int goal) {
     for (int k = 0; k < 8; ++k) {
       const int jx = ix + dx[k];
       const int jy = iy + dy[k];
-      if (!Traversable(jx, jy)) continue;
+      if (!TraversableOnce(jx, jy)) continue;
       // Diagonal moves must not cut the corner of a blocked cell.
-      if (k >= 4 && (!Traversable(ix + dx[k], iy) || !Traversable(ix, iy + dy[k]))) continue;
+      if (k >= 4 && (!TraversableOnce(ix + dx[k], iy) || !TraversableOnce(ix, iy + dy[k]))) {
+        continue;
+      }
       const int j = grid_.Index(jx, jy);
       const double step = (k < 4 ? r : r * std::sqrt(2.0)) * StepCostFactor((*clearance_)[j]);
       // Compared as stored (float): a double compared with its own rounding
       // would re-push a cell at an equal cost, without end.
       const float next = static_cast<float>(cost + step);
-      Node& neighbour = nodes_.try_emplace(j, Node{std::numeric_limits<float>::infinity(), -1,
-                                                   false}).first->second;
+      Node& neighbour = Reach(j);
       if (!neighbour.settled && next < neighbour.cost) {
         neighbour.cost = next;
         neighbour.parent = top.index;
@@ -186,8 +206,8 @@ bool NavigationMap::SearchTo(const Eigen::Vector2i& goal) {
   if (!grid_.Contains(goal.x(), goal.y()) || open_.empty()) return false;
   const int goal_index = grid_.Index(goal.x(), goal.y());
   for (;;) {
-    const auto it = nodes_.find(goal_index);
-    if (it != nodes_.end() && it->second.settled) return true;
+    const Node* node = Reached(goal_index);
+    if (node != nullptr && node->settled) return true;
     if (!SettleNext(goal_index)) return false;
   }
 }
@@ -226,8 +246,8 @@ bool NavigationMap::TraversableAt(const Eigen::Vector2d& p_W) const {
 
 double NavigationMap::CostTo(int ix, int iy) const {
   if (!grid_.Contains(ix, iy)) return kInfinity;
-  const auto it = nodes_.find(grid_.Index(ix, iy));
-  return it != nodes_.end() && it->second.settled ? it->second.cost : kInfinity;
+  const Node* node = Reached(grid_.Index(ix, iy));
+  return node != nullptr && node->settled ? node->cost : kInfinity;
 }
 
 bool NavigationMap::SegmentTraversable(const Eigen::Vector2d& a_W,
@@ -243,7 +263,7 @@ bool NavigationMap::SegmentTraversable(const Eigen::Vector2d& a_W,
 std::vector<Eigen::Vector2i> NavigationMap::CellPath(const Eigen::Vector2i& goal) const {
   std::vector<Eigen::Vector2i> cells;
   if (!std::isfinite(CostTo(goal.x(), goal.y()))) return cells;
-  for (int i = grid_.Index(goal.x(), goal.y()); i >= 0; i = nodes_.at(i).parent) {
+  for (int i = grid_.Index(goal.x(), goal.y()); i >= 0; i = table_->nodes[i].parent) {
     cells.push_back(grid_.limits().CellOfIndex(i));
   }
   std::reverse(cells.begin(), cells.end());

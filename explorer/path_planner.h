@@ -1,7 +1,8 @@
 #pragma once
 
 #include <cstdint>
-#include <unordered_map>
+#include <limits>
+#include <memory>
 #include <vector>
 
 #include <Eigen/Core>
@@ -50,8 +51,10 @@ double ClearanceCapM(const ExplorerParams& params);
 /// robot stopped close to a wall can plan its way out.
 ///
 /// The search runs on demand and touches only the cells it reaches (their
-/// costs live in a hash table, traversability is read per cell), so that its
-/// cost follows the cells searched, not the grid's size: `Search::kFull`
+/// costs and traversability, computed once per cell, live in a per-cell
+/// table that the maps of one thread reuse, each entry stamped with the map
+/// that wrote it, so that a new map clears nothing), so that its cost follows
+/// the cells searched, not the grid's size: `Search::kFull`
 /// costs every reachable cell at construction; with `Search::kOnDemand` the
 /// caller runs ExpandTo (Dijkstra up to a cost, resumable) or SearchTo (A* to
 /// one cell, octile distance as the heuristic), not both.
@@ -75,6 +78,7 @@ class NavigationMap {
   NavigationMap(const OccupancyGrid& grid, const ClearanceField& clearance,
                 const ExplorerParams& params, const Eigen::Vector2d& p_W_start,
                 Search search = Search::kFull);
+  ~NavigationMap();
   NavigationMap(const NavigationMap&) = delete;
   NavigationMap& operator=(const NavigationMap&) = delete;
 
@@ -115,12 +119,22 @@ class NavigationMap {
   Eigen::Vector2i start_cell() const { return start_; }
 
  private:
-  // A cell reached by the search: its cost so far (float, compared as
-  // stored), the linear index of the cell before it (-1: none), settled.
+  // A cell looked at by the search: its cost so far (float, compared as
+  // stored; infinite until reached), the linear index of the cell before it
+  // (-1: none), settled, whether it is Traversable (0: not known yet, 1: no,
+  // 2: yes); the stamp of the map that wrote it (any other stamp: not looked
+  // at).
   struct Node {
     float cost;
     int parent;
+    std::uint32_t stamp;
     bool settled;
+    std::uint8_t traversable;
+  };
+  // The per-cell table of one thread's maps (see the class comment).
+  struct NodeTable {
+    std::vector<Node> nodes;
+    std::uint32_t last_stamp = 0;
   };
   // An entry of the open list: priority (cost, plus the heuristic for A*),
   // cost when pushed, linear index; ordered by priority, then index.
@@ -152,8 +166,33 @@ class NavigationMap {
   ClearanceField own_clearance_;
   // Per cell of the grid: clearance, metres (the field's values).
   const Grid2<float>* clearance_;
-  // The cells reached, by linear index, and the open list.
-  std::unordered_map<int, Node> nodes_;
+  // Node tables no map of this thread holds now, for the next maps.
+  static thread_local std::vector<std::unique_ptr<NodeTable>> spare_tables_;
+  // The cell's node, by linear index: looked at by this map, or null.
+  const Node* Reached(int index) const {
+    const Node& node = table_->nodes[index];
+    return node.stamp == stamp_ ? &node : nullptr;
+  }
+  // The cell's node, made a fresh one (infinite cost) if not looked at yet.
+  Node& Reach(int index) {
+    Node& node = table_->nodes[index];
+    if (node.stamp != stamp_) {
+      node = Node{std::numeric_limits<float>::infinity(), -1, stamp_, false, 0};
+    }
+    return node;
+  }
+  // Traversable(ix, iy), computed once per cell.
+  bool TraversableOnce(int ix, int iy) {
+    if (!grid_.Contains(ix, iy)) return false;
+    Node& node = Reach(grid_.Index(ix, iy));
+    if (node.traversable == 0) node.traversable = Traversable(ix, iy) ? 2 : 1;
+    return node.traversable == 2;
+  }
+
+  // The cells looked at (a table taken from the thread's spares, given
+  // back by the destructor), this map's stamp in it, and the open list.
+  std::unique_ptr<NodeTable> table_;
+  std::uint32_t stamp_ = 0;
   std::vector<Open> open_;
   double expanded_cost_m_ = 0.0;
   int settled_ = 0;

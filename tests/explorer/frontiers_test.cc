@@ -178,5 +178,48 @@ TEST(FrontiersTest, GainEqualsCountingEverySample) {
   EXPECT_GT(decided_below, 300);  // both answers occur
 }
 
+TEST(FrontiersTest, CachedGainsFollowTheGridAsItChanges) {
+  // Scans from seeded poses (seed 11) inserted one by one into a room with
+  // clutter; after each, the cached gain of every point of a fixed set
+  // equals a fresh count, to the last bit. Between scans, the gains of some
+  // points change (a cache that kept every entry would fail) and those of
+  // others do not.
+  Rng rng(11);
+  std::vector<testing::Wall> walls = {{{-1, -1}, {15, -1}}, {{15, -1}, {15, 9}},
+                                      {{15, 9}, {-1, 9}}, {{-1, 9}, {-1, -1}}};
+  for (int i = 0; i < 30; ++i) {
+    const Eigen::Vector2d a(14.0 * rng.Uniform(), 8.0 * rng.Uniform());
+    const double th = 2.0 * kPi * rng.Uniform();
+    walls.push_back(
+        {a, a + (0.3 + 1.5 * rng.Uniform()) * Eigen::Vector2d(std::cos(th), std::sin(th))});
+  }
+  std::vector<Eigen::Vector2d> points;
+  for (int i = 0; i < 150; ++i) {
+    points.emplace_back(-2.0 + 18.0 * rng.Uniform(), -2.0 + 12.0 * rng.Uniform());
+  }
+  testing::KinematicSim::Config config;
+  config.max_range_m = 4.0;
+  const ExplorerParams params;
+  OccupancyGrid grid{params};
+  GainCache cache;
+  std::vector<double> last(points.size(), 0.0);
+  int changed = 0;
+  int kept = 0;
+  for (int scan = 0; scan < 12; ++scan) {
+    testing::KinematicSim sim(walls, Pose2(14.0 * rng.Uniform(), 8.0 * rng.Uniform(),
+                                           2.0 * kPi * rng.Uniform()), config);
+    grid.InsertScan(sim.Scan(0.0), sim.X_WR() * config.X_RS);
+    for (size_t i = 0; i < points.size(); ++i) {
+      const double expected = InformationGain(grid, points[i], params.gain_radius_m);
+      EXPECT_EQ(cache.Gain(grid, points[i], params.gain_radius_m), expected)
+          << "scan " << scan << " at " << points[i].transpose();
+      if (scan > 0) (expected != last[i] ? changed : kept) += 1;
+      last[i] = expected;
+    }
+  }
+  EXPECT_GT(changed, 50);
+  EXPECT_GT(kept, 500);
+}
+
 }  // namespace
 }  // namespace mjslam::explorer

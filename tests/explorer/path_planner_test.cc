@@ -281,6 +281,43 @@ TEST(NavigationMapTest, SearchesOnDemandGiveTheCostsOfTheWholeSearch) {
   EXPECT_FALSE(astar.SearchTo(grid.CellOf(Eigen::Vector2d(6.0, 4.0))));
 }
 
+TEST(NavigationMapTest, MapsThatReuseATableSeeNothingOfEachOther) {
+  // Maps from two starts, side by side (each with its own table), then in
+  // turn (each taking the table the last one gave back): every map sees
+  // only its own search, with the same costs.
+  const ExplorerParams params;
+  const OccupancyGrid grid = MappedLCorridor();
+  const std::vector<Eigen::Vector2d> starts = {{1.0, 1.0}, {5.0, 7.0}};
+  std::vector<std::vector<double>> costs(starts.size());
+  {
+    const NavigationMap a(grid, params, starts[0]);
+    const NavigationMap b(grid, params, starts[1]);
+    for (int iy = 0; iy < grid.height(); ++iy) {
+      for (int ix = 0; ix < grid.width(); ++ix) {
+        costs[0].push_back(a.CostTo(ix, iy));
+        costs[1].push_back(b.CostTo(ix, iy));
+      }
+    }
+  }
+  ASSERT_NE(costs[0], costs[1]);
+  for (int round = 0; round < 3; ++round) {
+    for (size_t k = 0; k < starts.size(); ++k) {
+      NavigationMap map(grid, params, starts[k], NavigationMap::Search::kOnDemand);
+      int finite = 0;
+      for (int iy = 0; iy < grid.height(); ++iy) {
+        for (int ix = 0; ix < grid.width(); ++ix) finite += std::isfinite(map.CostTo(ix, iy));
+      }
+      EXPECT_EQ(finite, 0) << "round " << round << " start " << k;
+      map.ExpandTo(std::numeric_limits<double>::infinity());
+      std::vector<double> got;
+      for (int iy = 0; iy < grid.height(); ++iy) {
+        for (int ix = 0; ix < grid.width(); ++ix) got.push_back(map.CostTo(ix, iy));
+      }
+      EXPECT_EQ(got, costs[k]) << "round " << round << " start " << k;
+    }
+  }
+}
+
 TEST(NavigationMapTest, SearchCostDoesNotGrowWithTheMappedArea) {
   // The same start and goal, 4 m apart, in corridors of 10 m and 40 m: the
   // searches on demand settle the same cells, the whole search four times
