@@ -36,6 +36,41 @@ const Eigen::Vector2d& Residue(FeatureType type) {
   return type == FeatureType::kLine ? kLineResidue : kCornerResidue;
 }
 
+// The global map's covariance is too large for the cache; its transposed
+// reads go by tiles of this many rows and columns.
+constexpr int kTile = 64;
+
+// P <- (P + P^T) / 2, tile by tile: the same values as the expression on
+// the whole matrix (each pair's sum is formed once; the diagonal stays).
+void Symmetrize(Eigen::MatrixXd* P) {
+  const int n = static_cast<int>(P->rows());
+  for (int j0 = 0; j0 < n; j0 += kTile) {
+    for (int i0 = j0; i0 < n; i0 += kTile) {
+      for (int j = j0; j < std::min(j0 + kTile, n); ++j) {
+        for (int i = std::max(i0, j + 1); i < std::min(i0 + kTile, n); ++i) {
+          const double mean = 0.5 * ((*P)(i, j) + (*P)(j, i));
+          (*P)(i, j) = mean;
+          (*P)(j, i) = mean;
+        }
+      }
+    }
+  }
+}
+
+// The strictly upper triangle of P <- that of P^T, tile by tile.
+void MirrorLower(Eigen::MatrixXd* P) {
+  const int n = static_cast<int>(P->rows());
+  for (int j0 = 0; j0 < n; j0 += kTile) {
+    for (int i0 = j0; i0 < n; i0 += kTile) {
+      for (int j = j0; j < std::min(j0 + kTile, n); ++j) {
+        for (int i = std::max(i0, j + 1); i < std::min(i0 + kTile, n); ++i) {
+          (*P)(j, i) = (*P)(i, j);
+        }
+      }
+    }
+  }
+}
+
 // The quantities a join carries to W, y = [x_B', c, f_k...] of the submap
 // (c: its nc self-calibration entries as they are now; f_k its features
 // listed), with their Jacobians by the old base x_B and by the submap's
@@ -308,7 +343,7 @@ JoinReport JoinSubmap(const EkfSlam& submap, const SubmapLink& link, const EkfPa
     xg.noalias() += shared.M.transpose() * shared.delta;
     const Eigen::MatrixXd DM = shared.D * shared.M;
     Pg.noalias() -= shared.M.transpose() * DM;
-    Pg = 0.5 * (Pg + Pg.transpose()).eval();
+    Symmetrize(&Pg);
   }
   const Eigen::Vector3d base = xg.head<3>();
 
@@ -488,7 +523,7 @@ JoinReport JoinSubmap(const EkfSlam& submap, const SubmapLink& link, const EkfPa
     const Eigen::MatrixXd V = PHt * W;
     x.noalias() += V * (W.transpose() * nu);
     P.selfadjointView<Eigen::Lower>().rankUpdate(V, -1.0);
-    P.triangularView<Eigen::StrictlyUpper>() = P.transpose().eval();
+    MirrorLower(&P);
     x(2) = WrapAngle(x(2));
   }
 
