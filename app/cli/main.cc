@@ -1,6 +1,7 @@
 // mjslam: the command line. One function adds each subcommand's options and
 // one runs it; main() builds the CLI and dispatches. With the tests, the only
 // place that catches errors.
+#include <malloc.h>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
@@ -709,6 +710,13 @@ int RenderMain(RenderCommand c) {
 
 int main(int argc, char** argv) {
   namespace app = mjslam::app;
+  // Large blocks (a global map's covariance: tens of MB) come from the heap
+  // and go back to it, not to the system: glibc maps every block above its
+  // threshold (at most 32 MB) afresh, or trims the heap's top when one is
+  // freed, and a join that allocates several faulted in every page of each
+  // again.
+  mallopt(M_MMAP_THRESHOLD, 1 << 30);
+  mallopt(M_TRIM_THRESHOLD, 1 << 30);
   CLI::App cli{"mjslam: laser EKF-SLAM testbed on a simulated Pioneer 3-DX (MuJoCo)"};
   cli.set_version_flag("--version", app::MjslamVersion() + " (" + app::MjslamGitCommit() + ")");
   cli.require_subcommand(1);
