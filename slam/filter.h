@@ -50,9 +50,8 @@ class Filter {
   virtual int num_features() const = 0;
   /// Whether the filter predicts from the odometry pose X_OR (true) or from
   /// the held command (false). In realtime timing a busy filter skips
-  /// records: one of odometry input is given only the next record it
-  /// processes, with dt the time since its last one; one of command input
-  /// is given each skipped record's command first (prediction only).
+  /// records: either kind is given each skipped record first (prediction
+  /// only).
   virtual bool predicts_from_odometry() const = 0;
   /// A filter that keeps its map in submaps: the times (records' t_s) at
   /// which each submap after the first began, in order; empty for others.

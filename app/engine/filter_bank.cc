@@ -70,30 +70,27 @@ void FilterBank::Step(const SensorRecord& record) {
       const Clock::time_point start = Clock::now();
       const slam::ScanFeatures* given = record.has_scan ? &features : nullptr;
       f.report = f.timing == FilterTiming::kEveryScan ? f.filter->Step(record, given)
-                                                      : CatchUpAndStep(&f, step, record, given);
+                                                      : CatchUpAndStep(&f, record, given);
       // A submap's join runs beside the filter: not in its processing time.
       f.processing_us = extraction_us + MicrosecondsSince(start) - f.report.beside_us;
       f.processing_s = ProcessingSeconds(control_, f.report, record.has_scan, f.processing_us);
       f.period_steps = CommandPeriodSteps(f.processing_s, dt_s_);
       f.total_processing_s += f.processing_s;
       f.next_free_step = step + f.period_steps;
-      f.last_processed_t_s = record.t_s;
       if (record.has_scan) ++f.scans_processed;
       f.innovation_check.Add(record.t_s, f.report.nis_sum, f.report.num_matched,
                              f.report.num_observed,
                              f.innovation_check.NearMisses(f.report.nearest_nis),
                              f.innovation_check.Copies(f.report.association, f.report.nearest_nis));
     } else {
-      // Busy: the scan is lost; with command input the record's command
-      // waits for the next prediction.
-      if (!f.filter->predicts_from_odometry()) {
-        SensorRecord motion;
-        motion.t_s = record.t_s;
-        motion.dt_s = record.dt_s;
-        motion.command = record.command;
-        motion.X_OR = record.X_OR;
-        f.skipped_records.push_back(motion);
-      }
+      // Busy: the scan is lost; the record's motion (its command, its
+      // odometry pose) waits for the next prediction.
+      SensorRecord motion;
+      motion.t_s = record.t_s;
+      motion.dt_s = record.dt_s;
+      motion.command = record.command;
+      motion.X_OR = record.X_OR;
+      f.skipped_records.push_back(motion);
       slam::StepReport held;
       held.num_features = f.report.num_features;
       f.report = held;
@@ -111,21 +108,16 @@ void FilterBank::Step(const SensorRecord& record) {
   }
 }
 
-slam::StepReport FilterBank::CatchUpAndStep(Slot* f, int step, const SensorRecord& record,
+slam::StepReport FilterBank::CatchUpAndStep(Slot* f, const SensorRecord& record,
                                           const slam::ScanFeatures* features) {
-  // Command input: one prediction per skipped record, each with its own
-  // command and dt, as if the filter had run them.
+  // One prediction per skipped record, each with its own command, odometry
+  // increment and dt, as if the filter had run them: one prediction over
+  // the whole period would take its noise and its self-calibration
+  // Jacobians from the net increment and the last command, which a turn in
+  // place followed by a drive does not resemble.
   for (const SensorRecord& skipped : f->skipped_records) f->filter->Step(skipped, nullptr);
   f->skipped_records.clear();
-  // (The first record, step 0, has no earlier one: it predicts nothing.)
-  if (!f->filter->predicts_from_odometry() || step == 0) {
-    return f->filter->Step(record, features);
-  }
-  // Odometry input: the filter takes the increment from the odometry pose of
-  // its last processed record; dt is the whole time since that record.
-  SensorRecord since_last = record;
-  since_last.dt_s = record.t_s - f->last_processed_t_s;
-  return f->filter->Step(since_last, features);
+  return f->filter->Step(record, features);
 }
 
 std::vector<rundir::FilterRow> FilterBank::Rows(const Pose2& X_WR_true) {

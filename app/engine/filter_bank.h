@@ -58,11 +58,8 @@ class FilterBank {
   /// with an earlier record skips this one (processed(i) is false after the
   /// call): its estimate and map stay those of its last processed record.
   /// A filter that is free predicts over every step since its last processed
-  /// record, then processes this one: with command input, one prediction per
-  /// skipped record with that record's own command and dt; with odometry
-  /// input (slam::Filter::predicts_from_odometry), one prediction from the
-  /// odometry pose of its last processed record to this one's, dt the time
-  /// between them.
+  /// record, one prediction per skipped record with that record's own
+  /// command, odometry increment and dt, then processes this one.
   void Step(const SensorRecord& record);
 
   /// Every filter's columns of trajectory.csv after the last step, in the
@@ -123,10 +120,8 @@ class FilterBank {
     double open_loop_s = 0.0;
     int steps_to_next_command = 0;
     // Realtime timing: the first step at which the filter is free again,
-    // the time of its last processed record, and (command input) the
-    // records of the steps it skipped since, without their scans.
+    // and the records of the steps it skipped since, without their scans.
     int next_free_step = 0;
-    double last_processed_t_s = 0.0;
     std::vector<SensorRecord> skipped_records;
     bool processed = true;
     // The true pose at the last processed step: what the estimate is of.
@@ -135,9 +130,9 @@ class FilterBank {
     int scans_skipped = 0;
   };
   // Realtime timing: filter `f` catches up over the records it skipped and
-  // processes `record`, the record of control step `step` (the features
-  // when it has a scan). Returns the filter's step report.
-  slam::StepReport CatchUpAndStep(Slot* f, int step, const SensorRecord& record,
+  // processes `record` (the features when it has a scan). Returns the
+  // filter's step report.
+  slam::StepReport CatchUpAndStep(Slot* f, const SensorRecord& record,
                                   const slam::ScanFeatures* features);
 
   slam::SlamParams params_;
