@@ -72,9 +72,6 @@ class DeadReckoningFilter : public slam::Filter {
   Eigen::Matrix3d pose_covariance() const override { return P_; }
   std::vector<MapFeature> Map() const override { return {}; }
   int num_features() const override { return 0; }
-  // In realtime timing a busy filter is given the next record's odometry
-  // pose, not each skipped command.
-  bool predicts_from_odometry() const override { return true; }
 
  private:
   double a_m_;

@@ -41,10 +41,6 @@ def inverse(a):
 
 
 class DeadReckoningFilter:
-    # In realtime timing a busy filter is given the next record's odometry pose, not each
-    # skipped command (slam::Filter::predicts_from_odometry).
-    predicts_from_odometry = True
-
     def __init__(self, settings, X_WR0, X_RS):
         # settings["slam"] is the run's `slam` section as config.yaml writes it, with this
         # entry's own keys (settings["filter"]) applied; X_WR0 the known start pose of R, X_RS

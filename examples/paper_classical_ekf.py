@@ -19,8 +19,7 @@ provides:
                           frame S); returns a dict of slam::StepReport's fields (slam/ekf_slam.h),
                           which feed the command period's cost model and the innovation check;
   pose(), covariance()    the estimate (x, y, th) of R in W and its 3x3 covariance;
-  num_features(), map()   the map's size, and its features as dicts;
-  predicts_from_odometry  a class attribute, as slam::Filter's.
+  num_features(), map()   the map's size, and its features as dicts.
 
 This one copies the C++ classical filter (kind ekf, `update: classical`: EkfSlam in
 slam/ekf_slam.cc and SlamState in slam/slam_state.cc) under the paper's method
@@ -65,10 +64,6 @@ class SlamInputError(ValueError):
 
 class PaperClassicalEkf:
     """The classical EKF-SLAM of slam/ekf_slam.cc (Algorithm 1) under configs/paper.yaml."""
-
-    # Filter::predicts_from_odometry(): the process model is of kind command, so in realtime
-    # timing the loop gives a busy filter each skipped record's command first (features None).
-    predicts_from_odometry = False
 
     # --- construction: EkfSlam::EkfSlam, SlamState::SlamState -----------------------------------
 

@@ -104,16 +104,12 @@ py::array_t<double> Matrices2(const std::vector<Item>& items, F f) {
 // A filter written in Python, run by the closed loop as any slam::Filter.
 // The Python object implements the protocol of python/README.md ("A filter in
 // Python"): step(record, features) -> dict or None, pose(), covariance(),
-// num_features(), map(), and the attribute predicts_from_odometry.
+// num_features() and map().
 
 class PythonFilter : public slam::Filter {
  public:
   PythonFilter(std::string name, std::string kind, py::object filter)
-      : where_("filter '" + name + "' (kind " + kind + ")"), filter_(std::move(filter)) {
-    predicts_from_odometry_ = py::hasattr(filter_, "predicts_from_odometry")
-                                  ? filter_.attr("predicts_from_odometry").cast<bool>()
-                                  : true;
-  }
+      : where_("filter '" + name + "' (kind " + kind + ")"), filter_(std::move(filter)) {}
   ~PythonFilter() override {
     py::gil_scoped_acquire gil;
     filter_ = py::object();
@@ -220,8 +216,6 @@ class PythonFilter : public slam::Filter {
     return filter_.attr("num_features")().cast<int>();
   }
 
-  bool predicts_from_odometry() const override { return predicts_from_odometry_; }
-
  private:
   static int* IntField(slam::StepReport* r, const std::string& key) {
     if (key == "num_features") return &r->num_features;
@@ -296,7 +290,6 @@ class PythonFilter : public slam::Filter {
 
   std::string where_;
   py::object filter_;
-  bool predicts_from_odometry_ = true;
 };
 
 // The Python classes registered as filter kinds, by kind. Never freed: the

@@ -11,7 +11,6 @@ CorrectionMode CorrectionModeFromName(const std::string& update) {
 EkfFilter::EkfFilter(const FilterSettings& settings, const Pose2& X_WR0, const Pose2& X_RS,
                      Rng rng)
     : ekf_(settings.slam.ekf, CorrectionModeFromName(settings.filter.update), X_WR0, X_RS,
-           std::move(rng)),
-      odometry_(PredictsFromOdometry(settings.slam.ekf.process_model)) {}
+           std::move(rng)) {}
 
 }  // namespace mjslam::slam

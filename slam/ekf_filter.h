@@ -24,14 +24,12 @@ class EkfFilter : public Filter {
   Eigen::Matrix3d pose_covariance() const override { return ekf_.pose_covariance(); }
   std::vector<MapFeature> Map() const override { return ekf_.Map(); }
   int num_features() const override { return ekf_.num_features(); }
-  bool predicts_from_odometry() const override { return odometry_; }
 
   /// The EKF itself (for tests and tools that need its whole state).
   const EkfSlam& ekf() const { return ekf_; }
 
  private:
   EkfSlam ekf_;
-  bool odometry_;
 };
 
 /// The CorrectionMode of an `update` value: "classical" or "selective".

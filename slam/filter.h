@@ -48,11 +48,6 @@ class Filter {
   virtual std::vector<MapFeature> Map() const = 0;
   /// L, the number of map features.
   virtual int num_features() const = 0;
-  /// Whether the filter predicts from the odometry pose X_OR (true) or from
-  /// the held command (false). In realtime timing a busy filter skips
-  /// records: either kind is given each skipped record first (prediction
-  /// only).
-  virtual bool predicts_from_odometry() const = 0;
   /// A filter that keeps its map in submaps: the times (records' t_s) at
   /// which each submap after the first began, in order; empty for others.
   virtual std::vector<double> SubmapStartTimes() const { return {}; }

@@ -18,7 +18,6 @@ SubmapFilter::SubmapFilter(const FilterSettings& settings, const Pose2& X_WR0, c
       mode_(CorrectionModeFromName(settings.filter.update)),
       X_RS_(X_RS),
       rng_(std::move(rng)),
-      odometry_(PredictsFromOdometry(settings.slam.ekf.process_model)),
       max_features_(settings.filter.submap_max_features) {
   if (max_features_ < 1) {
     throw ParamError("submap_max_features: expected a value >= 1 (got " +

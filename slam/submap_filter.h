@@ -42,7 +42,6 @@ class SubmapFilter : public Filter {
   /// Global features plus the current submap's (some of which a join would
   /// fuse with global ones).
   int num_features() const override;
-  bool predicts_from_odometry() const override { return odometry_; }
   std::vector<double> SubmapStartTimes() const override { return start_times_; }
 
   /// The global map as joined so far (without the current submap).
@@ -68,7 +67,6 @@ class SubmapFilter : public Filter {
   CorrectionMode mode_;
   Pose2 X_RS_;
   Rng rng_;
-  bool odometry_;
   int max_features_;
   JoinedMap global_;
   std::unique_ptr<EkfSlam> submap_;

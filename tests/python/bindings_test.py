@@ -98,7 +98,6 @@ def test_the_map_as_arrays_is_map_csv(tmp_path):
 class Recorder:
     """A Python filter that keeps what it is given and reports the true... nothing: it stays
     at its start pose, with a fixed covariance."""
-    predicts_from_odometry = True
     seen = []
 
     def __init__(self, settings, X_WR0, X_RS):

@@ -379,7 +379,6 @@ class CountingFilter : public slam::Filter {
   Eigen::Matrix3d pose_covariance() const override { return Eigen::Matrix3d::Identity(); }
   std::vector<MapFeature> Map() const override { return {}; }
   int num_features() const override { return steps_; }
-  bool predicts_from_odometry() const override { return true; }
 
  private:
   int steps_ = 0;
