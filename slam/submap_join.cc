@@ -36,39 +36,34 @@ const Eigen::Vector2d& Residue(FeatureType type) {
   return type == FeatureType::kLine ? kLineResidue : kCornerResidue;
 }
 
-// The global map's covariance is too large for the cache; its transposed
-// reads go by tiles of this many rows and columns.
-constexpr int kTile = 64;
-
-// P <- (P + P^T) / 2, tile by tile: the same values as the expression on
-// the whole matrix (each pair's sum is formed once; the diagonal stays).
-void Symmetrize(Eigen::MatrixXd* P) {
-  const int n = static_cast<int>(P->rows());
+// Calls pair(i, j) for every i > j < n, tile by tile: the global map's
+// covariance is too large for the cache, and reading it transposed by whole
+// columns missed it.
+template <typename Pair>
+void ForLowerPairsByTiles(int n, Pair pair) {
+  constexpr int kTile = 64;
   for (int j0 = 0; j0 < n; j0 += kTile) {
     for (int i0 = j0; i0 < n; i0 += kTile) {
       for (int j = j0; j < std::min(j0 + kTile, n); ++j) {
-        for (int i = std::max(i0, j + 1); i < std::min(i0 + kTile, n); ++i) {
-          const double mean = 0.5 * ((*P)(i, j) + (*P)(j, i));
-          (*P)(i, j) = mean;
-          (*P)(j, i) = mean;
-        }
+        for (int i = std::max(i0, j + 1); i < std::min(i0 + kTile, n); ++i) pair(i, j);
       }
     }
   }
 }
 
-// The strictly upper triangle of P <- that of P^T, tile by tile.
+// P <- (P + P^T) / 2: the same values as the expression on the whole
+// matrix (each pair's sum is formed once; the diagonal stays).
+void Symmetrize(Eigen::MatrixXd* P) {
+  ForLowerPairsByTiles(static_cast<int>(P->rows()), [P](int i, int j) {
+    const double mean = 0.5 * ((*P)(i, j) + (*P)(j, i));
+    (*P)(i, j) = mean;
+    (*P)(j, i) = mean;
+  });
+}
+
+// The strictly upper triangle of P <- that of P^T.
 void MirrorLower(Eigen::MatrixXd* P) {
-  const int n = static_cast<int>(P->rows());
-  for (int j0 = 0; j0 < n; j0 += kTile) {
-    for (int i0 = j0; i0 < n; i0 += kTile) {
-      for (int j = j0; j < std::min(j0 + kTile, n); ++j) {
-        for (int i = std::max(i0, j + 1); i < std::min(i0 + kTile, n); ++i) {
-          (*P)(j, i) = (*P)(i, j);
-        }
-      }
-    }
-  }
+  ForLowerPairsByTiles(static_cast<int>(P->rows()), [P](int i, int j) { (*P)(j, i) = (*P)(i, j); });
 }
 
 // The quantities a join carries to W, y = [x_B', c, f_k...] of the submap
